@@ -1,0 +1,207 @@
+// `femto render`: loads a scene (or the built-in one), renders it and writes the outputs.
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <optional>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "apps/cli.h"
+#include "apps/commands.h"
+#include "core/default_scene.h"
+#include "core/error.h"
+#include "core/outputs.h"
+#include "core/progress.h"
+#include "core/render.h"
+#include "core/scene_loader.h"
+#include "femto_version.h"
+
+namespace femto {
+
+namespace {
+const char* kRenderHelp =
+    "Usage: femto render [SCENE.json] [options]\n"
+    "\n"
+    "Renders a time-resolved image (H x W x T) of SCENE.json, or of the built-in default scene\n"
+    "(a pulsed spot light in fog behind a glass sphere) when no scene is given.\n"
+    "\n"
+    "Options (override the scene's \"render\" block):\n"
+    "  --spp N            samples (camera paths) per pixel, 1..10^7 (scene default: 16)\n"
+    "  --seed S           random seed, integer >= 0; the same seed gives bit-identical output\n"
+    "                     for any thread count (scene default: 1)\n"
+    "  --threads N        worker threads, 0 = all cores (default 0)\n"
+    "  --max-depth N      safety bound on scattering/bounce vertices per path; paths stopped by\n"
+    "                     it are counted in render.json (scene default: 1000)\n"
+    "  --out DIR          output folder, created if missing (default ./femto-out)\n"
+    "  --frames MODE      per-bin EXR frames: files (frames/*.exr, default), multipart\n"
+    "                     (one transient.exr with a part per bin) or none\n"
+    "  --no-previews      skip the PNG previews (steady.png, frames.png)\n"
+    "  --max-memory SIZE  refuse to render when the film needs more than SIZE (e.g. 2G);\n"
+    "                     default 75% of physical memory\n"
+    "  --quiet            no progress or summary on stderr\n"
+    "  --help             this help\n"
+    "\n"
+    "Outputs (see docs/outputs.md): steady.exr, frames/*.exr, peak_time.exr, transient.npy\n"
+    "(float32, shape (H, W, T, 3)), before_window.exr, after_window.exr, steady.png,\n"
+    "frames.png and render.json (settings, time axis in ps and OPL mm, timings, counters).\n";
+
+nlohmann::json rgb_json(const RGB& c) { return nlohmann::json::array({c.r, c.g, c.b}); }
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the scene file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+}  // namespace
+
+int cmd_render(const std::vector<std::string>& argv, const std::string& command_line) {
+  cli::Args args("femto render", argv);
+  std::string scene_path;
+  std::optional<int> spp, max_depth;
+  std::optional<uint64_t> seed;
+  int threads = 0;
+  OutputOptions out;
+  bool quiet = false;
+  uint64_t max_memory = cli::physical_memory_bytes() / 4 * 3;
+  while (!args.done()) {
+    const std::string a = args.next();
+    if (a == "--help" || a == "-h") {
+      std::fputs(kRenderHelp, stdout);
+      return 0;
+    } else if (a == "--spp") {
+      spp = static_cast<int>(args.int_value(1, 10000000));
+    } else if (a == "--seed") {
+      seed = args.uint_value();
+    } else if (a == "--threads") {
+      threads = static_cast<int>(args.int_value(0, 4096));
+    } else if (a == "--max-depth") {
+      max_depth = static_cast<int>(args.int_value(1, 1000000));
+    } else if (a == "--out") {
+      out.dir = args.value();
+      if (out.dir.empty()) args.fail("expects a folder", "");
+    } else if (a == "--frames") {
+      const std::string v = args.value();
+      if (v == "files") out.frames = OutputOptions::Frames::Files;
+      else if (v == "multipart") out.frames = OutputOptions::Frames::Multipart;
+      else if (v == "none") out.frames = OutputOptions::Frames::None;
+      else args.fail("expected files, multipart or none", v);
+    } else if (a == "--no-previews") {
+      out.previews = false;
+    } else if (a == "--max-memory") {
+      max_memory = args.size_value();
+    } else if (a == "--quiet" || a == "-q") {
+      quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      args.fail("unknown option (see femto render --help)", a);
+    } else if (scene_path.empty()) {
+      scene_path = a;
+    } else {
+      args.fail("only one scene file may be given", a);
+    }
+  }
+
+  // Load and validate everything before anything is written.
+  std::string scene_text;
+  SceneDesc desc;
+  if (scene_path.empty()) {
+    scene_text = default_scene_json();
+    desc = load_scene_string(scene_text, "<default scene>", ".");
+  } else {
+    scene_text = read_text(scene_path);
+    desc = load_scene_file(scene_path);
+  }
+  RenderOptions opt;
+  opt.spp = spp.value_or(desc.integrator.spp);
+  opt.seed = seed.value_or(desc.integrator.seed);
+  opt.max_depth = max_depth.value_or(desc.integrator.max_depth);
+  opt.threads = threads;
+  opt.quiet = quiet;
+  const CameraDesc& cam = desc.camera;
+  const TimeAxis axis = desc.time;
+  const uint64_t film_bytes = TransientFilm::memory_bytes(cam.width, cam.height, axis.bins);
+  if (film_bytes > max_memory)
+    throw InputError("film needs " + cli::format_bytes(film_bytes) + " (" + std::to_string(cam.width) +
+                     " x " + std::to_string(cam.height) + " pixels x " + std::to_string(axis.bins) +
+                     " bins x RGB float32), more than --max-memory " + cli::format_bytes(max_memory) +
+                     ": lower the resolution or the number of bins, or raise --max-memory");
+  if (!quiet)
+    std::fprintf(stderr, "femto: %s: %d x %d pixels, %d bins of %.4g ps from %.4g ps, %d spp; film memory %s\n",
+                 desc.source.c_str(), cam.width, cam.height, axis.bins, axis.bin_width_ps, axis.t_start_ps,
+                 opt.spp, cli::format_bytes(film_bytes).c_str());
+
+  const Scene scene(std::move(desc));
+  const RenderResult result = render(scene, opt);
+  const PathStats& st = result.stats;
+
+  nlohmann::json info;
+  info["femto_version"] = FEMTO_VERSION;
+  info["femto_build"] = FEMTO_GIT_DESCRIBE;
+  info["command"] = command_line;
+  info["date_utc"] = utc_now();
+  info["scene"] = {{"source", scene.desc().source},
+                   {"json", nlohmann::json::parse(scene_text, nullptr, false)}};
+  info["settings"] = {{"spp", opt.spp},
+                      {"seed", opt.seed},
+                      {"threads", result.threads},
+                      {"max_depth", opt.max_depth},
+                      {"integrator", "volpath (mean-free-path sampling, NEE + MIS)"},
+                      {"reconstruction", "histogram"},
+                      {"russian_roulette", false}};
+  info["time_axis"] = {{"t_start_ps", axis.t_start_ps},
+                       {"bin_width_ps", axis.bin_width_ps},
+                       {"bins", axis.bins},
+                       {"t_end_ps", axis.t_end_ps()},
+                       {"start_opl_mm", TimeAxis::opl_of_time(axis.t_start_ps)},
+                       {"bin_width_opl_mm", TimeAxis::opl_of_time(axis.bin_width_ps)},
+                       {"end_opl_mm", TimeAxis::opl_of_time(axis.t_end_ps())},
+                       {"mode", scene.desc().time_mode == TimeMode::Camera ? "camera" : "unwarp"},
+                       {"speed_of_light_mm_per_ps", kSpeedOfLight}};
+  info["film"] = {{"width", cam.width},
+                  {"height", cam.height},
+                  {"bins", axis.bins},
+                  {"npy_shape", {cam.height, cam.width, axis.bins, 3}},
+                  {"dtype", "float32"},
+                  {"units", "radiance integrated over each bin; sum over bins = steady.exr"},
+                  {"memory_bytes", film_bytes}};
+  info["counters"] = {{"paths", st.paths},
+                      {"medium_scattering_events", st.medium_events},
+                      {"surface_events", st.surface_events},
+                      {"null_boundary_crossings", st.null_crossings},
+                      {"max_depth_terminations", st.max_depth_hits},
+                      {"nonfinite_samples_dropped", st.nonfinite_dropped}};
+  info["timing"] = {{"render_seconds", result.wall_seconds},
+                    {"paths_per_second", result.wall_seconds > 0 ? static_cast<double>(st.paths) / result.wall_seconds : 0.0}};
+  info["energy"] = {{"in_window", rgb_json(result.film.total_steady())},
+                    {"before_window", rgb_json(result.film.total_before())},
+                    {"after_window", rgb_json(result.film.total_after())},
+                    {"note", "sums over pixels; after_window only counts contributions of paths "
+                             "still alive (paths stop once they pass the window end)"}};
+  write_outputs(result.film, out, info);
+  if (!quiet) {
+    std::fprintf(stderr, "femto: %llu paths in %s (%.3g paths/s, %d threads)\n",
+                 static_cast<unsigned long long>(st.paths), format_duration(result.wall_seconds).c_str(),
+                 info["timing"]["paths_per_second"].get<double>(), result.threads);
+    if (st.max_depth_hits > 0)
+      std::fprintf(stderr, "femto: warning: %llu paths reached --max-depth %d (counted in render.json)\n",
+                   static_cast<unsigned long long>(st.max_depth_hits), opt.max_depth);
+    if (st.nonfinite_dropped > 0)
+      std::fprintf(stderr, "femto: warning: %llu non-finite contributions dropped\n",
+                   static_cast<unsigned long long>(st.nonfinite_dropped));
+    std::fprintf(stderr, "femto: results in %s/ (steady.png, frames.png, steady.exr, frames/, transient.npy, render.json)\n",
+                 out.dir.c_str());
+  }
+  return 0;
+}
+
+}  // namespace femto

@@ -1,0 +1,195 @@
+#include "core/geometry.h"
+
+#include <embree3/rtcore.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+
+namespace femto {
+
+namespace {
+
+struct SphereData {
+  Vec3 center;
+  double radius;
+};
+
+// Nearest root of |o + s d - c|^2 = r^2 in (s_min, s_max), computed in double precision.
+bool intersect_sphere(const SphereData& sp, const Vec3& o, const Vec3& d, double s_min,
+                      double s_max, double& s_hit) {
+  const Vec3 oc = o - sp.center;
+  const double b = dot(oc, d);
+  // Stable discriminant: |oc - b d|^2 avoids cancellation for far-away origins.
+  const Vec3 perp = oc - d * b;
+  const double disc = sp.radius * sp.radius - dot(perp, perp);
+  if (disc < 0.0) return false;
+  const double q = std::sqrt(disc);
+  const double s0 = -b - q, s1 = -b + q;
+  if (s0 > s_min && s0 < s_max) { s_hit = s0; return true; }
+  if (s1 > s_min && s1 < s_max) { s_hit = s1; return true; }
+  return false;
+}
+
+void sphere_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto* sp = static_cast<const SphereData*>(args->geometryUserPtr);
+  const float pad = 1e-4f * static_cast<float>(sp->radius);
+  args->bounds_o->lower_x = static_cast<float>(sp->center.x - sp->radius) - pad;
+  args->bounds_o->lower_y = static_cast<float>(sp->center.y - sp->radius) - pad;
+  args->bounds_o->lower_z = static_cast<float>(sp->center.z - sp->radius) - pad;
+  args->bounds_o->upper_x = static_cast<float>(sp->center.x + sp->radius) + pad;
+  args->bounds_o->upper_y = static_cast<float>(sp->center.y + sp->radius) + pad;
+  args->bounds_o->upper_z = static_cast<float>(sp->center.z + sp->radius) + pad;
+}
+
+// Ray context carrying the double-precision ray, so sphere hits are exact to double precision.
+struct FemtoContext {
+  RTCIntersectContext rtc;
+  Vec3 o, d;
+};
+
+void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
+  if (!args->valid[0]) return;
+  const auto* sp = static_cast<const SphereData*>(args->geometryUserPtr);
+  const auto* ctx = reinterpret_cast<const FemtoContext*>(args->context);
+  RTCRayHit* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+  double s;
+  if (!intersect_sphere(*sp, ctx->o, ctx->d, rh->ray.tnear, rh->ray.tfar, s)) return;
+  const Vec3 n = (ctx->o + ctx->d * s - sp->center) / sp->radius;
+  rh->ray.tfar = static_cast<float>(s);
+  rh->hit.Ng_x = static_cast<float>(n.x);
+  rh->hit.Ng_y = static_cast<float>(n.y);
+  rh->hit.Ng_z = static_cast<float>(n.z);
+  rh->hit.u = 0.0f;
+  rh->hit.v = 0.0f;
+  rh->hit.primID = args->primID;
+  rh->hit.geomID = args->geomID;
+  rh->hit.instID[0] = args->context->instID[0];
+}
+
+
+}  // namespace
+
+struct Geometry::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<SphereData> spheres;            // indexed by shape (unused for triangle shapes)
+  std::vector<const ShapeDesc*> shapes;       // geomID == shape index
+  std::vector<std::vector<Vec3>> tri_normals;  // double-precision normals per shape
+  Vec3 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
+};
+
+Geometry::Geometry(const SceneDesc& desc) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.device = rtcNewDevice("threads=1");  // Embree builds serially; femto's own tasks use TBB
+  if (!m.device) throw RuntimeError("Embree: cannot create a device");
+  m.scene = rtcNewScene(m.device);
+  rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
+  m.spheres.resize(desc.shapes.size());
+  m.tri_normals.resize(desc.shapes.size());
+  for (size_t i = 0; i < desc.shapes.size(); ++i) {
+    const ShapeDesc& sh = desc.shapes[i];
+    m.shapes.push_back(&sh);
+    RTCGeometry g;
+    if (sh.type == ShapeDesc::Type::Sphere) {
+      m.spheres[i] = {sh.center, sh.radius};
+      g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
+      rtcSetGeometryUserPrimitiveCount(g, 1);
+      rtcSetGeometryUserData(g, &m.spheres[i]);
+      rtcSetGeometryBoundsFunction(g, sphere_bounds, nullptr);
+      rtcSetGeometryIntersectFunction(g, sphere_intersect);
+      m.lo = vmin(m.lo, sh.center - Vec3(sh.radius));
+      m.hi = vmax(m.hi, sh.center + Vec3(sh.radius));
+    } else {
+      g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), sh.vertices.size()));
+      for (size_t k = 0; k < sh.vertices.size(); ++k) {
+        v[3 * k + 0] = static_cast<float>(sh.vertices[k].x);
+        v[3 * k + 1] = static_cast<float>(sh.vertices[k].y);
+        v[3 * k + 2] = static_cast<float>(sh.vertices[k].z);
+        m.lo = vmin(m.lo, sh.vertices[k]);
+        m.hi = vmax(m.hi, sh.vertices[k]);
+      }
+      auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), sh.triangles.size()));
+      auto& normals = m.tri_normals[i];
+      normals.reserve(sh.triangles.size());
+      for (size_t k = 0; k < sh.triangles.size(); ++k) {
+        const auto& t = sh.triangles[k];
+        for (int c = 0; c < 3; ++c) idx[3 * k + c] = t[c];
+        const Vec3 n = cross(sh.vertices[t[1]] - sh.vertices[t[0]], sh.vertices[t[2]] - sh.vertices[t[0]]);
+        const double len = length(n);
+        normals.push_back(len > 0 ? n / len : Vec3(0, 0, 1));
+      }
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(m.scene, g, static_cast<unsigned>(i));
+    rtcReleaseGeometry(g);
+  }
+  rtcCommitScene(m.scene);
+  if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE)
+    throw RuntimeError("Embree failed to build the scene's acceleration structure");
+  if (desc.shapes.empty()) {
+    m.lo = Vec3(-0.5);
+    m.hi = Vec3(0.5);
+  }
+}
+
+Geometry::~Geometry() {
+  if (impl_) {
+    if (impl_->scene) rtcReleaseScene(impl_->scene);
+    if (impl_->device) rtcReleaseDevice(impl_->device);
+  }
+}
+
+Vec3 Geometry::bounds_min() const { return impl_->lo; }
+Vec3 Geometry::bounds_max() const { return impl_->hi; }
+
+bool Geometry::intersect(const Ray& ray, double s_min, double s_max, SurfaceHit& hit) const {
+  FemtoContext ctx;
+  rtcInitIntersectContext(&ctx.rtc);
+  ctx.o = ray.o;
+  ctx.d = ray.d;
+  RTCRayHit rh;
+  rh.ray.org_x = static_cast<float>(ray.o.x);
+  rh.ray.org_y = static_cast<float>(ray.o.y);
+  rh.ray.org_z = static_cast<float>(ray.o.z);
+  rh.ray.dir_x = static_cast<float>(ray.d.x);
+  rh.ray.dir_y = static_cast<float>(ray.d.y);
+  rh.ray.dir_z = static_cast<float>(ray.d.z);
+  rh.ray.tnear = static_cast<float>(s_min);
+  rh.ray.tfar = s_max < 3e38 ? static_cast<float>(s_max) : std::numeric_limits<float>::infinity();
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &ctx.rtc, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  const int shape = static_cast<int>(rh.hit.geomID);
+  const ShapeDesc& sh = *impl_->shapes[static_cast<size_t>(shape)];
+  hit.shape = shape;
+  hit.prim = static_cast<int>(rh.hit.primID);
+  if (sh.type == ShapeDesc::Type::Sphere) {
+    // Re-solve in double precision: Embree's tfar is float.
+    const SphereData& sp = impl_->spheres[static_cast<size_t>(shape)];
+    double s = rh.ray.tfar;
+    if (!intersect_sphere(sp, ray.o, ray.d, s_min, s_max, s)) s = rh.ray.tfar;
+    hit.s = s;
+    hit.p = ray.at(s);
+    hit.ng = normalize(hit.p - sp.center);
+  } else {
+    hit.s = rh.ray.tfar;
+    hit.p = ray.at(hit.s);
+    hit.ng = impl_->tri_normals[static_cast<size_t>(shape)][static_cast<size_t>(hit.prim)];
+  }
+  return true;
+}
+
+}  // namespace femto

@@ -1,0 +1,251 @@
+#include "core/integrators/volpath.h"
+
+#include <cmath>
+#include <limits>
+
+#include "core/constants.h"
+#include "core/sampling.h"
+#include "media/phase_hg.h"
+#include "samplers/distance.h"
+
+namespace femto {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kMaxNullCrossings = 4096;  // guards against rays trapped between coincident faces
+
+// Unpolarised Fresnel reflectance of a smooth dielectric; eta = eta_t / eta_i.
+double fresnel_dielectric(double cos_i, double eta, double& cos_t) {
+  const double sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+  if (sin2_t >= 1.0) {
+    cos_t = 0.0;
+    return 1.0;  // total internal reflection
+  }
+  cos_t = std::sqrt(1.0 - sin2_t);
+  const double r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  const double r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  return 0.5 * (r_par * r_par + r_perp * r_perp);
+}
+}  // namespace
+
+PathStats& PathStats::operator+=(const PathStats& o) {
+  paths += o.paths;
+  medium_events += o.medium_events;
+  surface_events += o.surface_events;
+  null_crossings += o.null_crossings;
+  max_depth_hits += o.max_depth_hits;
+  nonfinite_dropped += o.nonfinite_dropped;
+  return *this;
+}
+
+VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& filter,
+                                     int max_depth)
+    : scene_(scene),
+      filter_(filter),
+      max_depth_(max_depth),
+      unwarp_(scene.desc().time_mode == TimeMode::Unwarp) {
+  // Contributions are deposited with up to 8 sigma of pulse spread (see TemporalFilter).
+  t_cut_ = filter.axis().t_end_ps() - scene.lights().min_offset_ps() +
+           8.0 * scene.lights().max_sigma_ps();
+}
+
+void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
+                                PixelAccumulator& acc, PathStats& stats) const {
+  if (!value.is_finite() || !std::isfinite(t_ps)) {
+    ++stats.nonfinite_dropped;
+    return;
+  }
+  if (value.is_black()) return;
+  const DepositSplit split = filter_.deposit(t_ps, sigma_ps, value, acc.bins.data());
+  if (split.before > 0) acc.before += value * split.before;
+  if (split.after > 0) acc.after += value * split.after;
+}
+
+bool VolPathIntegrator::connect(const Vec3& x, int m, const Vec3& wi, double dist, double& Tr,
+                                double& time_ps, PathStats& stats) const {
+  const auto& media = scene_.media();
+  const double eps = scene_.ray_epsilon();
+  double optical_depth = 0.0, opl = 0.0;
+  Ray ray{x, wi};
+  double remaining = dist;
+  for (int k = 0; k < kMaxNullCrossings; ++k) {
+    SurfaceHit hit;
+    const double s_max = remaining - eps;
+    const bool found = s_max > eps && scene_.geometry().intersect(ray, 0.0, s_max, hit);
+    const double s = found ? hit.s : remaining;
+    optical_depth += media[static_cast<size_t>(m)].sigma_t() * s;
+    opl += media[static_cast<size_t>(m)].eta * s;
+    if (!found) {
+      Tr = std::exp(-optical_depth);
+      time_ps = opl / kSpeedOfLight;
+      return true;
+    }
+    if (scene_.desc().shapes[static_cast<size_t>(hit.shape)].material.type !=
+        MaterialDesc::Type::None)
+      return false;
+    ++stats.null_crossings;
+    m = dot(wi, hit.ng) < 0 ? scene_.inside_medium(hit.shape) : scene_.outside_medium();
+    ray.o = hit.p + wi * eps;
+    remaining -= s + eps;
+  }
+  return false;
+}
+
+void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats) const {
+  const auto& media = scene_.media();
+  const auto& shapes = scene_.desc().shapes;
+  const LightSet& lights = scene_.lights();
+  const double eps = scene_.ray_epsilon();
+  ++stats.paths;
+
+  int m = scene_.outside_medium();
+  RGB beta(1.0);
+  double t = 0.0;             // time of flight from the sensor to the current vertex, ps
+  bool on_camera_segment = true;  // unwarp mode drops the time of the sensor's own segment
+  bool specular = true;       // previous vertex was the sensor or a specular surface
+  double prev_pdf = 0.0;      // solid-angle pdf of the direction sampled at the previous vertex
+  Vec3 prev_p = ray.o;
+  int depth = 0;
+  int null_crossings = 0;
+
+  for (;;) {
+    SurfaceHit hit;
+    const bool found = scene_.geometry().intersect(ray, 0.0, kInf, hit);
+    const double s_surf = found ? hit.s : kInf;
+    const HomogeneousMedium& med = media[static_cast<size_t>(m)];
+    const double sigma_t = med.sigma_t();
+    // A purely absorbing medium is integrated exactly instead of sampled.
+    const double s_med = med.sigma_s > 0 ? sample_exponential(sigma_t, rng.uniform()) : kInf;
+    const double s = std::fmin(s_med, s_surf);
+    if (!std::isfinite(s)) break;  // escaped to infinity
+    if (!(med.sigma_s > 0) && sigma_t > 0) beta *= std::exp(-sigma_t * s);
+    if (!(unwarp_ && on_camera_segment)) t += med.eta * s / kSpeedOfLight;
+    if (t > t_cut_) break;
+
+    if (s_med < s_surf) {
+      // Real collision: absorb by weighting with the single-scattering albedo.
+      on_camera_segment = false;
+      ++stats.medium_events;
+      if (depth >= max_depth_) {
+        ++stats.max_depth_hits;
+        break;
+      }
+      ++depth;
+      beta *= med.albedo();
+      if (beta.is_black()) break;
+      const Vec3 x = ray.at(s_med);
+      // Next-event estimation to one light.
+      double pmf = 0;
+      const int li = lights.pick(rng.uniform(), pmf);
+      const double u1 = rng.uniform(), u2 = rng.uniform();
+      LightSample ls;
+      if (li >= 0 && lights.sample(li, x, u1, u2, ls)) {
+        const double f = hg_eval(dot(ray.d, ls.wi), med.g);
+        double Tr, dt;
+        if (f > 0 && connect(x, m, ls.wi, ls.dist, Tr, dt, stats)) {
+          const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, f);
+          const Light& L = lights.light(li);
+          deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(),
+                  beta * ls.Li * (f * Tr * w / (pmf * ls.pdf)), acc, stats);
+        }
+      }
+      // Phase sampling: HG is sampled exactly, so the weight f / pdf is 1.
+      const PhaseSample ps = hg_sample(ray.d, med.g, rng.uniform(), rng.uniform());
+      prev_pdf = ps.value;
+      specular = false;
+      prev_p = x;
+      ray = {x, ps.dir};
+      continue;
+    }
+
+    // Surface interaction.
+    const ShapeDesc& sh = shapes[static_cast<size_t>(hit.shape)];
+    const bool front = dot(ray.d, hit.ng) < 0;
+    if (sh.emissive && front) {
+      const int li = lights.light_of_shape(hit.shape);
+      double w = 1.0;
+      if (!specular) {
+        const double p_light = lights.pmf(li) * lights.pdf_area(li, prev_p, hit.p, hit.ng);
+        w = power_heuristic(prev_pdf, p_light);
+      }
+      deposit(t + sh.pulse.offset_ps, sh.pulse.sigma_ps(), beta * sh.emission * w, acc, stats);
+    }
+    if (sh.material.type == MaterialDesc::Type::None) {
+      // Index-matched boundary: change medium, keep going straight.
+      ++stats.null_crossings;
+      if (++null_crossings > kMaxNullCrossings) break;
+      m = front ? scene_.inside_medium(hit.shape) : scene_.outside_medium();
+      ray.o = hit.p + ray.d * eps;
+      continue;
+    }
+    on_camera_segment = false;
+    ++stats.surface_events;
+    if (depth >= max_depth_) {
+      ++stats.max_depth_hits;
+      break;
+    }
+    ++depth;
+    const Vec3 ns = front ? hit.ng : -hit.ng;  // normal on the side the ray came from
+    const Vec3 wo = -ray.d;
+
+    switch (sh.material.type) {
+      case MaterialDesc::Type::Diffuse: {
+        const RGB& albedo = sh.material.albedo;
+        double pmf = 0;
+        const int li = lights.pick(rng.uniform(), pmf);
+        const double u1 = rng.uniform(), u2 = rng.uniform();
+        LightSample ls;
+        const Vec3 x = hit.p + ns * eps;
+        if (li >= 0 && lights.sample(li, x, u1, u2, ls)) {
+          const double cos_i = dot(ns, ls.wi);
+          double Tr, dt;
+          if (cos_i > 0 && connect(x, m, ls.wi, ls.dist, Tr, dt, stats)) {
+            const double bsdf_pdf = cos_i * kInvPi;
+            const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, bsdf_pdf);
+            const Light& L = lights.light(li);
+            deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(),
+                    beta * albedo * ls.Li * (kInvPi * cos_i * Tr * w / (pmf * ls.pdf)), acc, stats);
+          }
+        }
+        const Vec3 local = sample_cosine_hemisphere(rng.uniform(), rng.uniform());
+        const Vec3 wi = normalize(Frame(ns).to_world(local));
+        beta *= albedo;  // (albedo / pi) cos / (cos / pi)
+        prev_pdf = cosine_hemisphere_pdf(local.z);
+        specular = false;
+        prev_p = hit.p;
+        ray = {x, wi};
+        break;
+      }
+      case MaterialDesc::Type::Mirror: {
+        beta *= sh.material.reflectance;
+        specular = true;
+        prev_p = hit.p;
+        ray = {hit.p + ns * eps, normalize(ray.d - ns * (2.0 * dot(ray.d, ns)))};
+        break;
+      }
+      case MaterialDesc::Type::Dielectric: {
+        const double eta_out = media[static_cast<size_t>(scene_.outside_medium())].eta;
+        const double eta_in = sh.material.eta;
+        const double eta = front ? eta_in / eta_out : eta_out / eta_in;  // eta_t / eta_i
+        const double cos_i = dot(wo, ns);
+        double cos_t;
+        const double F = fresnel_dielectric(cos_i, eta, cos_t);
+        specular = true;
+        prev_p = hit.p;
+        if (rng.uniform() < F) {
+          ray = {hit.p + ns * eps, normalize(ray.d + ns * (2.0 * cos_i))};
+        } else {
+          const Vec3 dir = normalize(ray.d / eta + ns * (cos_i / eta - cos_t));
+          beta *= 1.0 / (eta * eta);  // radiance scales with 1 / eta^2 across the interface
+          m = front ? scene_.inside_medium(hit.shape) : scene_.outside_medium();
+          ray = {hit.p - ns * eps, dir};
+        }
+        break;
+      }
+      case MaterialDesc::Type::None:
+        break;
+    }
+  }
+}
+
+}  // namespace femto

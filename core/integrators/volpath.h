@@ -1,0 +1,64 @@
+#pragma once
+// Transient volumetric path tracer: camera paths with mean-free-path distance sampling in
+// homogeneous media, next-event estimation through media and index-matched boundaries, and MIS
+// between light sampling and phase/BSDF sampling for area lights. Each contribution is stamped
+// with its path's time of flight (sum of eta * length / c over segments, plus the light's
+// emission time) and deposited into the pixel's time bins.
+#include <cstdint>
+#include <vector>
+
+#include "core/rng.h"
+#include "core/scene.h"
+#include "core/temporal_filter.h"
+
+namespace femto {
+
+/// Counters of one render; integer sums, so merging per-thread copies is deterministic.
+struct PathStats {
+  uint64_t paths = 0;
+  uint64_t medium_events = 0;      ///< real scattering events in media
+  uint64_t surface_events = 0;     ///< reflections/refractions at surfaces
+  uint64_t null_crossings = 0;     ///< passes through index-matched boundaries
+  uint64_t max_depth_hits = 0;     ///< paths stopped by the max-depth safety bound
+  uint64_t nonfinite_dropped = 0;  ///< contributions dropped for being NaN or infinite
+  PathStats& operator+=(const PathStats& o);
+};
+
+/// One pixel's running sums over its samples.
+struct PixelAccumulator {
+  std::vector<double> bins;  ///< T x 3
+  RGB before, after;         ///< energy that arrived before / after the window
+  void reset(int n_bins) {
+    bins.assign(static_cast<size_t>(n_bins) * 3, 0.0);
+    before = after = RGB(0.0);
+  }
+};
+
+class VolPathIntegrator {
+ public:
+  VolPathIntegrator(const Scene& scene, const TemporalFilter& filter, int max_depth);
+
+  /// Traces one camera path starting on `ray` (in the outside medium) and adds its
+  /// contributions to `acc`.
+  void trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
+
+  /// Path time beyond which no contribution can reach the window, ps.
+  double time_cutoff_ps() const { return t_cut_; }
+
+ private:
+  /// Transmittance and time of flight of a straight connection x -> x + dist * wi starting in
+  /// medium m, passing through index-matched boundaries; false if an opaque or refracting
+  /// surface blocks it.
+  bool connect(const Vec3& x, int m, const Vec3& wi, double dist, double& Tr, double& time_ps,
+               PathStats& stats) const;
+  void deposit(double t_ps, double sigma_ps, const RGB& value, PixelAccumulator& acc,
+               PathStats& stats) const;
+
+  const Scene& scene_;
+  TemporalFilter filter_;
+  int max_depth_;
+  bool unwarp_;
+  double t_cut_;
+};
+
+}  // namespace femto

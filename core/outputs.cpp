@@ -1,0 +1,108 @@
+#include "core/outputs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "core/io/atomic_file.h"
+#include "core/io/exr.h"
+#include "core/io/npy.h"
+#include "core/io/png.h"
+#include "core/io/tonemap.h"
+
+namespace femto {
+
+namespace fs = std::filesystem;
+
+std::string frame_file_name(const TimeAxis& axis, int t) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "frames/frame_%04d_%.3fps.exr", t, axis.bin_start_ps(t));
+  return buf;
+}
+
+void write_outputs(const TransientFilm& film, const OutputOptions& opt, nlohmann::json info) {
+  const fs::path dir(opt.dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw RuntimeError(opt.dir + ": cannot create the output folder: " + ec.message());
+  const int W = film.width(), H = film.height(), T = film.bins();
+  const TimeAxis& axis = film.axis();
+  const std::vector<std::pair<std::string, std::string>> attrs = {
+      {"femto:units", "bin-integrated radiance (sum over bins = steady image)"},
+      {"femto:time_axis", "t_start_ps=" + std::to_string(axis.t_start_ps) +
+                              " bin_width_ps=" + std::to_string(axis.bin_width_ps) +
+                              " bins=" + std::to_string(T)}};
+  nlohmann::json files = nlohmann::json::array();
+  auto path_of = [&](const std::string& name) { return (dir / name).string(); };
+
+  write_exr_rgb(path_of("steady.exr"), W, H, film.steady(), attrs);
+  files.push_back("steady.exr");
+  write_exr_rgb(path_of("before_window.exr"), W, H, film.before(), attrs);
+  files.push_back("before_window.exr");
+  write_exr_rgb(path_of("after_window.exr"), W, H, film.after(), attrs);
+  files.push_back("after_window.exr");
+  const std::vector<float> peak = film.peak_time();
+  write_exr_channels(path_of("peak_time.exr"), W, H, {"Y"}, {peak.data()},
+                     {{"femto:units", "ps (centre of the brightest bin; NaN where empty)"}});
+  files.push_back("peak_time.exr");
+
+  if (opt.frames == OutputOptions::Frames::Files) {
+    fs::create_directories(dir / "frames", ec);
+    if (ec) throw RuntimeError((dir / "frames").string() + ": cannot create folder: " + ec.message());
+    for (int t = 0; t < T; ++t) {
+      const std::vector<float> f = film.frame(t);
+      write_exr_rgb(path_of(frame_file_name(axis, t)), W, H, f.data(), attrs);
+    }
+    files.push_back("frames/");
+  } else if (opt.frames == OutputOptions::Frames::Multipart) {
+    std::vector<std::string> names;
+    for (int t = 0; t < T; ++t) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "t%04d_%.3fps", t, axis.bin_start_ps(t));
+      names.emplace_back(buf);
+    }
+    write_exr_multipart_rgb(path_of("transient.exr"), W, H, T, names, film.transient(), attrs);
+    files.push_back("transient.exr");
+  }
+
+  write_npy_float32(path_of("transient.npy"),
+                    {static_cast<size_t>(H), static_cast<size_t>(W), static_cast<size_t>(T), 3},
+                    film.transient());
+  files.push_back("transient.npy");
+
+  if (opt.previews) {
+    const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
+    const double exposure = auto_exposure(film.steady(), pixels);
+    const std::vector<uint8_t> img = tonemap_srgb8(film.steady(), pixels, exposure);
+    write_png_rgb8(path_of("steady.png"), W, H, img.data());
+    files.push_back("steady.png");
+    // Contact sheet: up to 16 frames evenly over the window, one exposure for all of them.
+    const int n = std::min(T, 16);
+    std::vector<int> idx;
+    std::vector<std::string> labels;
+    std::vector<float> chosen;
+    for (int k = 0; k < n; ++k) {
+      const int t = n == 1 ? 0 : static_cast<int>(std::lround(static_cast<double>(k) * (T - 1) / (n - 1)));
+      idx.push_back(t);
+      char buf[48];
+      std::snprintf(buf, sizeof buf, "t=%.1fps", axis.bin_start_ps(t));
+      labels.emplace_back(buf);
+      const std::vector<float> f = film.frame(t);
+      chosen.insert(chosen.end(), f.begin(), f.end());
+    }
+    const double frame_exposure = auto_exposure(chosen.data(), chosen.size() / 3);
+    int sw = 0, sh = 0;
+    const std::vector<uint8_t> sheet =
+        contact_sheet_rgb8(W, H, T, film.transient(), idx, labels, 4, frame_exposure, sw, sh);
+    write_png_rgb8(path_of("frames.png"), sw, sh, sheet.data());
+    files.push_back("frames.png");
+  }
+  files.push_back("render.json");
+  info["outputs"] = files;
+  write_text_atomically(path_of("render.json"), info.dump(2) + "\n");
+}
+
+}  // namespace femto

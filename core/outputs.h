@@ -1,0 +1,26 @@
+#pragma once
+// Writes a finished render to its output folder: EXR images and frames, transient.npy, PNG
+// previews and render.json. Every file is written to a temporary name and renamed into place,
+// and render.json is written last, so its presence marks a complete output.
+#include <string>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/film.h"
+
+namespace femto {
+
+struct OutputOptions {
+  enum class Frames { Files, Multipart, None };
+  std::string dir = "femto-out";
+  Frames frames = Frames::Files;
+  bool previews = true;  ///< steady.png and frames.png
+};
+
+/// File name of frame t inside the output folder, e.g. "frames/frame_0007_12.500ps.exr".
+std::string frame_file_name(const TimeAxis& axis, int t);
+
+/// Writes all outputs; `render_json` gets an "outputs" entry listing the files written.
+void write_outputs(const TransientFilm& film, const OutputOptions& options, nlohmann::json render_json);
+
+}  // namespace femto

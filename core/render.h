@@ -1,0 +1,30 @@
+#pragma once
+// Renders a scene into a transient film with oneTBB over image tiles.
+#include <cstdint>
+
+#include "core/film.h"
+#include "core/integrators/volpath.h"
+#include "core/scene.h"
+
+namespace femto {
+
+struct RenderOptions {
+  int spp = 16;
+  uint64_t seed = 1;
+  int threads = 0;       ///< 0: all hardware threads
+  int max_depth = 1000;
+  bool quiet = false;    ///< no progress on stderr
+};
+
+struct RenderResult {
+  TransientFilm film;
+  PathStats stats;
+  double wall_seconds = 0;
+  int threads = 0;
+};
+
+/// Traces spp paths per pixel. The result is bit-identical for a given seed whatever the thread
+/// count: every sample has its own random stream and each pixel sums its samples in order.
+RenderResult render(const Scene& scene, const RenderOptions& options);
+
+}  // namespace femto

@@ -1,0 +1,45 @@
+#pragma once
+// The renderable scene built from a SceneDesc: geometry, lights, camera and the media of every
+// region (the space outside all shapes, and each closed shape's interior).
+#include <vector>
+
+#include "core/camera.h"
+#include "core/geometry.h"
+#include "core/lights.h"
+#include "core/scene_desc.h"
+#include "media/homogeneous.h"
+
+namespace femto {
+
+class Scene {
+ public:
+  explicit Scene(SceneDesc desc);
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  const SceneDesc& desc() const { return desc_; }
+  const Geometry& geometry() const { return geometry_; }
+  const LightSet& lights() const { return lights_; }
+  const Camera& camera() const { return camera_; }
+
+  /// Media of all regions; index outside_medium() is the space outside all shapes (vacuum by
+  /// default). A dielectric shape without a named medium gets a clear medium of its own eta.
+  const std::vector<HomogeneousMedium>& media() const { return media_; }
+  int outside_medium() const { return outside_; }
+  /// Medium entered when a ray crosses shape i against its normal.
+  int inside_medium(int shape) const { return inside_[static_cast<size_t>(shape)]; }
+  /// Offset used to leave a surface without hitting it again, mm.
+  double ray_epsilon() const { return ray_eps_; }
+
+ private:
+  SceneDesc desc_;
+  Geometry geometry_;
+  LightSet lights_;
+  Camera camera_;
+  std::vector<HomogeneousMedium> media_;
+  std::vector<int> inside_;
+  int outside_ = 0;
+  double ray_eps_ = 1e-5;
+};
+
+}  // namespace femto

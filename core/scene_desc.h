@@ -1,0 +1,97 @@
+#pragma once
+// Plain description of a scene as read from JSON (docs/scene-format.md). The loader validates and
+// fills it; geometry, lights and the tracer are built from it.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/spectrum.h"
+#include "core/time_axis.h"
+#include "core/vec3.h"
+#include "media/homogeneous.h"
+
+namespace femto {
+
+/// Temporal profile of a light's emission: delta (fwhm 0) or Gaussian, centred at offset.
+struct PulseDesc {
+  double fwhm_ps = 0.0;    ///< full width at half maximum of a Gaussian pulse; 0 = delta
+  double offset_ps = 0.0;  ///< emission time of the pulse centre
+  double sigma_ps() const { return fwhm_ps / 2.3548200450309493; }  // FWHM = 2 sqrt(2 ln 2) sigma
+};
+
+struct CameraDesc {
+  enum class Type { Perspective, Orthographic };
+  Type type = Type::Perspective;
+  Vec3 position{0, 0, 0};
+  Vec3 look_at{0, 0, -1};
+  Vec3 up{0, 1, 0};
+  double fov_deg = 40.0;      ///< perspective: vertical field of view, degrees
+  double ortho_width = 1.0;   ///< orthographic: horizontal extent of the film, mm
+  int width = 64;
+  int height = 64;
+};
+
+struct MaterialDesc {
+  enum class Type { None, Diffuse, Mirror, Dielectric };
+  Type type = Type::None;        ///< None: an index-matched boundary that only bounds a medium
+  RGB albedo{0.5};               ///< diffuse reflectance
+  RGB reflectance{1.0};          ///< mirror reflectance
+  double eta = 1.5;              ///< dielectric: refractive index of the interior
+};
+
+struct MediumDesc {
+  std::string name;
+  HomogeneousMedium medium;
+};
+
+struct ShapeDesc {
+  enum class Type { Sphere, Quad, Box, Mesh };
+  Type type = Type::Sphere;
+  std::string where;             ///< JSON path for error messages, e.g. "/shapes/2"
+  // Sphere.
+  Vec3 center{0, 0, 0};
+  double radius = 1.0;
+  // Triangle shapes (quad, box, mesh) in world space, filled by the loader.
+  std::vector<Vec3> vertices;
+  std::vector<std::array<uint32_t, 3>> triangles;
+  MaterialDesc material;
+  int interior_medium = -1;      ///< index into SceneDesc::media; -1: none named
+  bool emissive = false;
+  RGB emission{0.0};             ///< radiance emitted from the front side (along the normal)
+  PulseDesc pulse;               ///< emission time profile when emissive
+};
+
+struct LightDesc {
+  enum class Type { Point, Spot, Laser };
+  Type type = Type::Point;
+  std::string where;
+  Vec3 position{0, 0, 0};
+  Vec3 direction{0, 0, -1};      ///< spot and laser: unit emission direction
+  RGB intensity{1.0};            ///< point and spot: radiant intensity, W/sr
+  double cone_angle_deg = 30.0;  ///< spot: half-angle of the cone, degrees
+  double falloff_deg = 25.0;     ///< spot: half-angle where the smooth falloff starts
+  double radius = 0.5;           ///< laser: beam radius, mm
+  RGB power{1.0};                ///< laser: total flux, W
+  PulseDesc pulse;
+};
+
+struct IntegratorDesc {
+  int spp = 16;
+  int max_depth = 1000;          ///< safety bound on scattering/bounce vertices per path
+  uint64_t seed = 1;
+};
+
+struct SceneDesc {
+  std::string source;            ///< file name, or "<default scene>"
+  CameraDesc camera;
+  TimeAxis time;
+  TimeMode time_mode = TimeMode::Camera;
+  std::vector<MediumDesc> media;
+  int global_medium = -1;        ///< medium filling everything outside closed shapes; -1 = vacuum
+  std::vector<ShapeDesc> shapes;
+  std::vector<LightDesc> lights;
+  IntegratorDesc integrator;
+};
+
+}  // namespace femto

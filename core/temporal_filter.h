@@ -1,0 +1,79 @@
+#pragma once
+// Temporal reconstruction: how one time-stamped contribution is spread over the film's time bins.
+// The histogram puts it in one bin; a light's Gaussian pulse is integrated exactly over the bins
+// it overlaps. A progressive kernel estimator will be a second kind behind this same interface.
+#include <cmath>
+
+#include "core/spectrum.h"
+#include "core/time_axis.h"
+
+namespace femto {
+
+/// Energy of one deposit that fell before, inside and after the window.
+struct DepositSplit {
+  double before = 0.0;
+  double inside = 0.0;
+  double after = 0.0;
+};
+
+class TemporalFilter {
+ public:
+  enum class Kind { Histogram };
+
+  TemporalFilter() = default;
+  TemporalFilter(const TimeAxis& axis, Kind kind) : axis_(axis), kind_(kind) {}
+
+  const TimeAxis& axis() const { return axis_; }
+  Kind kind() const { return kind_; }
+
+  /// Adds `value` arriving at t_ps, smeared by a Gaussian of std sigma_ps (0 = delta), into the
+  /// pixel's bin buffer `bins` (bins x 3 doubles). Returns the fractions outside the window.
+  DepositSplit deposit(double t_ps, double sigma_ps, const RGB& value, double* bins) const {
+    DepositSplit split;
+    if (sigma_ps <= 0.0) {
+      const int i = axis_.bin_of(t_ps);
+      if (i >= 0) {
+        add(bins, i, value, 1.0);
+        split.inside = 1.0;
+      } else if (t_ps < axis_.t_start_ps) {
+        split.before = 1.0;
+      } else {
+        split.after = 1.0;
+      }
+      return split;
+    }
+    // Exact integral of the Gaussian over each overlapped bin (CDF differences), +-8 sigma.
+    const double t0 = axis_.t_start_ps, w = axis_.bin_width_ps, t_end = axis_.t_end_ps();
+    split.before = gaussian_cdf((t0 - t_ps) / sigma_ps);
+    split.after = 1.0 - gaussian_cdf((t_end - t_ps) / sigma_ps);
+    const double lo = std::fmax(t0, t_ps - 8.0 * sigma_ps);
+    const double hi = std::fmin(t_end, t_ps + 8.0 * sigma_ps);
+    if (lo >= hi) return split;
+    int i = static_cast<int>((lo - t0) / w);
+    const int i_end = std::min(axis_.bins - 1, static_cast<int>((hi - t0) / w));
+    double cdf_prev = gaussian_cdf((t0 + i * w - t_ps) / sigma_ps);
+    for (; i <= i_end; ++i) {
+      const double cdf_next = gaussian_cdf((t0 + (i + 1) * w - t_ps) / sigma_ps);
+      const double f = cdf_next - cdf_prev;
+      cdf_prev = cdf_next;
+      if (f > 0.0) add(bins, i, value, f);
+      split.inside += f;
+    }
+    return split;
+  }
+
+  static double gaussian_cdf(double z) { return 0.5 * std::erfc(-z * 0.70710678118654752440); }
+
+ private:
+  static void add(double* bins, int i, const RGB& v, double f) {
+    double* b = bins + 3 * i;
+    b[0] += v.r * f;
+    b[1] += v.g * f;
+    b[2] += v.b * f;
+  }
+
+  TimeAxis axis_;
+  Kind kind_ = Kind::Histogram;
+};
+
+}  // namespace femto

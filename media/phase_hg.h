@@ -1,0 +1,40 @@
+#pragma once
+// Henyey–Greenstein phase function over the angle between propagation directions.
+#include <cmath>
+
+#include "core/constants.h"
+#include "core/vec3.h"
+
+namespace femto {
+
+/// p(cos_theta) for HG with asymmetry g; cos_theta is the cosine between the incident propagation
+/// direction and the scattered propagation direction. Integrates to 1 over the sphere.
+inline double hg_eval(double cos_theta, double g) {
+  const double denom = 1.0 + g * g - 2.0 * g * cos_theta;
+  return kInv4Pi * (1.0 - g * g) / (denom * std::sqrt(denom));
+}
+
+/// Inverse-CDF sample of cos_theta for HG from u in [0,1).
+inline double hg_sample_cos(double u, double g) {
+  if (std::abs(g) < 1e-3) return 1.0 - 2.0 * u;
+  const double sq = (1.0 - g * g) / (1.0 - g + 2.0 * g * u);
+  const double c = (1.0 + g * g - sq * sq) / (2.0 * g);
+  return std::fmax(-1.0, std::fmin(1.0, c));
+}
+
+struct PhaseSample {
+  Vec3 dir;      ///< new propagation direction
+  double value;  ///< phase function value (= pdf for HG)
+};
+
+/// Samples a new propagation direction around the current propagation direction `d`.
+inline PhaseSample hg_sample(const Vec3& d, double g, double u1, double u2) {
+  const double cos_t = hg_sample_cos(u1, g);
+  const double sin_t = std::sqrt(std::fmax(0.0, 1.0 - cos_t * cos_t));
+  const double phi = 2.0 * kPi * u2;
+  const Frame f(d);
+  const Vec3 dir = f.to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t});
+  return {normalize(dir), hg_eval(cos_t, g)};
+}
+
+}  // namespace femto

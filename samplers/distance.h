@@ -1,0 +1,22 @@
+#pragma once
+// Mean-free-path distance sampling in a homogeneous medium: p(s) = sigma_t exp(-sigma_t s).
+#include <cmath>
+#include <limits>
+
+namespace femto {
+
+/// Inverse CDF of the exponential distribution; u in [0,1). Returns +inf when sigma_t == 0.
+inline double sample_exponential(double sigma_t, double u) {
+  if (!(sigma_t > 0.0)) return std::numeric_limits<double>::infinity();
+  return -std::log1p(-u) / sigma_t;
+}
+
+/// Density of sample_exponential at s >= 0.
+inline double exponential_pdf(double sigma_t, double s) {
+  return s < 0.0 ? 0.0 : sigma_t * std::exp(-sigma_t * s);
+}
+
+/// Probability that the sampled distance exceeds s (the transmittance).
+inline double exponential_survival(double sigma_t, double s) { return std::exp(-sigma_t * s); }
+
+}  // namespace femto
