@@ -84,7 +84,7 @@ struct Geometry::Impl {
 
 Geometry::Geometry(const SceneDesc& desc) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
-  m.device = rtcNewDevice("threads=1");  // Embree builds serially; femto's own tasks use TBB
+  m.device = rtcNewDevice(nullptr);  // no "threads=N": Embree would cap all of TBB with it
   if (!m.device) throw RuntimeError("Embree: cannot create a device");
   m.scene = rtcNewScene(m.device);
   rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST);

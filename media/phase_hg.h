@@ -9,7 +9,9 @@ namespace femto {
 
 /// p(cos_theta) for HG with asymmetry g; cos_theta is the cosine between the incident propagation
 /// direction and the scattered propagation direction. Integrates to 1 over the sphere.
+/// Valid for |g| < 1; |g| < 1e-3 is treated as isotropic, exactly as hg_sample_cos samples it.
 inline double hg_eval(double cos_theta, double g) {
+  if (std::abs(g) < 1e-3) return kInv4Pi;
   const double denom = 1.0 + g * g - 2.0 * g * cos_theta;
   return kInv4Pi * (1.0 - g * g) / (denom * std::sqrt(denom));
 }

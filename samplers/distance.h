@@ -13,10 +13,14 @@ inline double sample_exponential(double sigma_t, double u) {
 
 /// Density of sample_exponential at s >= 0.
 inline double exponential_pdf(double sigma_t, double s) {
-  return s < 0.0 ? 0.0 : sigma_t * std::exp(-sigma_t * s);
+  if (s < 0.0 || sigma_t <= 0.0) return 0.0;
+  return sigma_t * std::exp(-sigma_t * s);
 }
 
 /// Probability that the sampled distance exceeds s (the transmittance).
-inline double exponential_survival(double sigma_t, double s) { return std::exp(-sigma_t * s); }
+inline double exponential_survival(double sigma_t, double s) {
+  if (s <= 0.0 || sigma_t <= 0.0) return 1.0;  // also avoids 0 * inf
+  return std::exp(-sigma_t * s);
+}
 
 }  // namespace femto

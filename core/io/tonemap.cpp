@@ -1,0 +1,161 @@
+#include "core/io/tonemap.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace femto {
+namespace {
+
+uint8_t encode_srgb8(double linear) {
+  if (!(linear > 0)) return 0;  // also catches NaN
+  if (linear >= 1) return 255;
+  const double v = linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
+  return static_cast<uint8_t>(std::lround(v * 255));
+}
+
+double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+
+// Collects finite, positive luminances (the pixels auto exposure looks at).
+void add_luminance(std::vector<double>& lum, const float* p) {
+  const double l = luminance(p);
+  if (l > 0 && std::isfinite(l)) lum.push_back(l);
+}
+
+// Scale putting the 99th percentile at 0.9 (reorders lum).
+double exposure_for(std::vector<double>& lum) {
+  if (lum.empty()) return 1.0;
+  const auto k = static_cast<size_t>(0.99 * static_cast<double>(lum.size() - 1));
+  std::nth_element(lum.begin(), lum.begin() + static_cast<std::ptrdiff_t>(k), lum.end());
+  return 0.9 / lum[k];
+}
+
+// 5x7 glyphs: one byte per row, top row first, bit 4 = leftmost column.
+struct Glyph {
+  char c;
+  uint8_t rows[7];
+};
+constexpr Glyph kFont[] = {
+    {'0', {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}}, {'1', {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+    {'2', {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}}, {'3', {0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E}},
+    {'4', {0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02}}, {'5', {0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E}},
+    {'6', {0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E}}, {'7', {0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08}},
+    {'8', {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}}, {'9', {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C}},
+    {'.', {0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C}}, {',', {0x00, 0x00, 0x00, 0x00, 0x0C, 0x04, 0x08}},
+    {'-', {0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00}}, {'+', {0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00}},
+    {'=', {0x00, 0x00, 0x1F, 0x00, 0x1F, 0x00, 0x00}}, {':', {0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x0C, 0x00}},
+    {'/', {0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00}}, {'(', {0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02}},
+    {')', {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08}}, {'_', {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1F}},
+    {'%', {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03}}, {'?', {0x0E, 0x11, 0x01, 0x02, 0x04, 0x00, 0x04}},
+    {' ', {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}},
+    {'a', {0x00, 0x00, 0x0E, 0x01, 0x0F, 0x11, 0x0F}}, {'b', {0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x1E}},
+    {'c', {0x00, 0x00, 0x0E, 0x10, 0x10, 0x11, 0x0E}}, {'d', {0x01, 0x01, 0x0D, 0x13, 0x11, 0x11, 0x0F}},
+    {'e', {0x00, 0x00, 0x0E, 0x11, 0x1F, 0x10, 0x0E}}, {'f', {0x06, 0x09, 0x08, 0x1C, 0x08, 0x08, 0x08}},
+    {'g', {0x00, 0x00, 0x0F, 0x11, 0x0F, 0x01, 0x0E}}, {'h', {0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x11}},
+    {'i', {0x04, 0x00, 0x0C, 0x04, 0x04, 0x04, 0x0E}}, {'j', {0x02, 0x00, 0x06, 0x02, 0x02, 0x12, 0x0C}},
+    {'k', {0x10, 0x10, 0x12, 0x14, 0x18, 0x14, 0x12}}, {'l', {0x0C, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+    {'m', {0x00, 0x00, 0x1A, 0x15, 0x15, 0x11, 0x11}}, {'n', {0x00, 0x00, 0x16, 0x19, 0x11, 0x11, 0x11}},
+    {'o', {0x00, 0x00, 0x0E, 0x11, 0x11, 0x11, 0x0E}}, {'p', {0x00, 0x00, 0x1E, 0x11, 0x1E, 0x10, 0x10}},
+    {'q', {0x00, 0x00, 0x0F, 0x11, 0x0F, 0x01, 0x01}}, {'r', {0x00, 0x00, 0x16, 0x19, 0x10, 0x10, 0x10}},
+    {'s', {0x00, 0x00, 0x0F, 0x10, 0x0E, 0x01, 0x1E}}, {'t', {0x08, 0x08, 0x1C, 0x08, 0x08, 0x09, 0x06}},
+    {'u', {0x00, 0x00, 0x11, 0x11, 0x11, 0x13, 0x0D}}, {'v', {0x00, 0x00, 0x11, 0x11, 0x11, 0x0A, 0x04}},
+    {'w', {0x00, 0x00, 0x11, 0x11, 0x15, 0x15, 0x0A}}, {'x', {0x00, 0x00, 0x11, 0x0A, 0x04, 0x0A, 0x11}},
+    {'y', {0x00, 0x00, 0x11, 0x11, 0x0F, 0x01, 0x0E}}, {'z', {0x00, 0x00, 0x1F, 0x02, 0x04, 0x08, 0x1F}},
+};
+constexpr int kGlyphW = 5, kGlyphH = 7, kAdvance = kGlyphW + 1;
+
+const uint8_t* glyph_rows(char c) {
+  if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  for (const Glyph& g : kFont)
+    if (g.c == c) return g.rows;
+  return glyph_rows('?');
+}
+
+// Draws text at (x0,y0) on a dark box, clipped to the rectangle [0,clip_w) x [0,clip_h)
+// offset by (ox,oy) in an image of row length `stride` pixels.
+void draw_label(std::vector<uint8_t>& img, int stride, int ox, int oy, int clip_w, int clip_h,
+                const std::string& text, int scale) {
+  const int pad = scale, x0 = 2 * scale, y0 = 2 * scale;
+  const int box_w = static_cast<int>(text.size()) * kAdvance * scale - scale + 2 * pad;
+  const int box_h = kGlyphH * scale + 2 * pad;
+  auto put = [&](int x, int y, uint8_t v) {
+    if (x < 0 || y < 0 || x >= clip_w || y >= clip_h) return;
+    uint8_t* p = &img[(static_cast<size_t>(oy + y) * stride + static_cast<size_t>(ox + x)) * 3];
+    p[0] = p[1] = p[2] = v;
+  };
+  for (int y = 0; y < box_h; ++y)
+    for (int x = 0; x < box_w; ++x) put(x0 - pad + x, y0 - pad + y, 0);
+  for (size_t i = 0; i < text.size(); ++i) {
+    const uint8_t* rows = glyph_rows(text[i]);
+    const int gx = x0 + static_cast<int>(i) * kAdvance * scale;
+    for (int r = 0; r < kGlyphH; ++r)
+      for (int c = 0; c < kGlyphW; ++c)
+        if (rows[r] & (0x10 >> c))
+          for (int sy = 0; sy < scale; ++sy)
+            for (int sx = 0; sx < scale; ++sx) put(gx + c * scale + sx, y0 + r * scale + sy, 255);
+  }
+}
+
+}  // namespace
+
+std::vector<uint8_t> tonemap_srgb8(const float* rgb, size_t pixels, double exposure_scale) {
+  std::vector<uint8_t> out(pixels * 3);
+  for (size_t i = 0; i < pixels * 3; ++i) out[i] = encode_srgb8(rgb[i] * exposure_scale);
+  return out;
+}
+
+double auto_exposure(const float* rgb, size_t pixels) {
+  std::vector<double> lum;
+  for (size_t i = 0; i < pixels; ++i) add_luminance(lum, rgb + 3 * i);
+  return exposure_for(lum);
+}
+
+std::vector<uint8_t> contact_sheet_rgb8(int width, int height, int bins, const float* hwtc,
+                                        const std::vector<int>& frame_indices,
+                                        const std::vector<std::string>& labels, int columns,
+                                        double exposure_scale, int& sheet_width, int& sheet_height) {
+  const int n = static_cast<int>(frame_indices.size());
+  if (width <= 0 || height <= 0 || bins <= 0 || !hwtc || n == 0)
+    throw RuntimeError("contact sheet: empty film or no frames selected");
+  for (int t : frame_indices)
+    if (t < 0 || t >= bins)
+      throw RuntimeError("contact sheet: frame " + std::to_string(t) + " outside [0, " +
+                         std::to_string(bins) + ")");
+  const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+  const auto bins_z = static_cast<size_t>(bins);
+  auto pixel = [&](size_t p, int t) { return hwtc + (p * bins_z + static_cast<size_t>(t)) * 3; };
+
+  if (!(exposure_scale > 0)) {  // one exposure for all frames keeps their brightness comparable
+    std::vector<double> lum;
+    for (int t : frame_indices)
+      for (size_t p = 0; p < pixels; ++p) add_luminance(lum, pixel(p, t));
+    exposure_scale = exposure_for(lum);
+  }
+
+  const int cols = columns > 0 ? std::min(columns, n)
+                               : static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  const int rows = (n + cols - 1) / cols;
+  const int gap = 4;
+  sheet_width = cols * width + (cols + 1) * gap;
+  sheet_height = rows * height + (rows + 1) * gap;
+  // Dark grey (not black) gap, so tile edges stay visible against black renders.
+  std::vector<uint8_t> sheet(static_cast<size_t>(sheet_width) * static_cast<size_t>(sheet_height) * 3,
+                             40);
+  const int scale = (width >= 256 && height >= 128) ? 2 : 1;
+
+  for (int i = 0; i < n; ++i) {
+    const int ox = gap + (i % cols) * (width + gap), oy = gap + (i / cols) * (height + gap);
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const float* src = pixel(static_cast<size_t>(y) * width + static_cast<size_t>(x), frame_indices[i]);
+        uint8_t* dst = &sheet[(static_cast<size_t>(oy + y) * sheet_width + static_cast<size_t>(ox + x)) * 3];
+        for (int c = 0; c < 3; ++c) dst[c] = encode_srgb8(src[c] * exposure_scale);
+      }
+    if (static_cast<size_t>(i) < labels.size() && !labels[i].empty())
+      draw_label(sheet, sheet_width, ox, oy, width, height, labels[i], scale);
+  }
+  return sheet;
+}
+
+}  // namespace femto
