@@ -51,6 +51,16 @@ struct FemtoContext {
   Vec3 o, d;
 };
 
+void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
+  if (!args->valid[0]) return;
+  const auto* sp = static_cast<const SphereData*>(args->geometryUserPtr);
+  const auto* ctx = reinterpret_cast<const FemtoContext*>(args->context);
+  RTCRay* ray = reinterpret_cast<RTCRay*>(args->ray);
+  double s;
+  if (intersect_sphere(*sp, ctx->o, ctx->d, ray->tnear, ray->tfar, s))
+    ray->tfar = -std::numeric_limits<float>::infinity();  // Embree's "occluded" mark
+}
+
 void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
   if (!args->valid[0]) return;
   const auto* sp = static_cast<const SphereData*>(args->geometryUserPtr);
@@ -102,6 +112,7 @@ Geometry::Geometry(const SceneDesc& desc) : impl_(std::make_unique<Impl>()) {
       rtcSetGeometryUserData(g, &m.spheres[i]);
       rtcSetGeometryBoundsFunction(g, sphere_bounds, nullptr);
       rtcSetGeometryIntersectFunction(g, sphere_intersect);
+      rtcSetGeometryOccludedFunction(g, sphere_occluded);
       m.lo = vmin(m.lo, sh.center - Vec3(sh.radius));
       m.hi = vmax(m.hi, sh.center + Vec3(sh.radius));
     } else {
@@ -149,6 +160,28 @@ Geometry::~Geometry() {
 
 Vec3 Geometry::bounds_min() const { return impl_->lo; }
 Vec3 Geometry::bounds_max() const { return impl_->hi; }
+
+bool Geometry::occluded(const Ray& ray, double s_min, double s_max) const {
+  FemtoContext ctx;
+  rtcInitIntersectContext(&ctx.rtc);
+  ctx.o = ray.o;
+  ctx.d = ray.d;
+  RTCRay r;
+  r.org_x = static_cast<float>(ray.o.x);
+  r.org_y = static_cast<float>(ray.o.y);
+  r.org_z = static_cast<float>(ray.o.z);
+  r.dir_x = static_cast<float>(ray.d.x);
+  r.dir_y = static_cast<float>(ray.d.y);
+  r.dir_z = static_cast<float>(ray.d.z);
+  r.tnear = static_cast<float>(s_min);
+  r.tfar = s_max < 3e38 ? static_cast<float>(s_max) : std::numeric_limits<float>::infinity();
+  r.time = 0.0f;
+  r.mask = 0xFFFFFFFFu;
+  r.id = 0;
+  r.flags = 0;
+  rtcOccluded1(impl_->scene, &ctx.rtc, &r);
+  return r.tfar < 0.0f;
+}
 
 bool Geometry::intersect(const Ray& ray, double s_min, double s_max, SurfaceHit& hit) const {
   FemtoContext ctx;

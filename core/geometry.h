@@ -25,6 +25,8 @@ class Geometry {
 
   /// Closest hit with s in (s_min, s_max); thread-safe.
   bool intersect(const Ray& ray, double s_min, double s_max, SurfaceHit& hit) const;
+  /// Whether any surface lies at s in (s_min, s_max); cheaper than intersect. Thread-safe.
+  bool occluded(const Ray& ray, double s_min, double s_max) const;
   /// Bounds of all shapes (empty scene: a unit box at the origin).
   Vec3 bounds_min() const;
   Vec3 bounds_max() const;

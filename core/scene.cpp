@@ -16,6 +16,7 @@ Scene::Scene(SceneDesc desc)
   inside_.assign(desc_.shapes.size(), outside_);
   for (size_t i = 0; i < desc_.shapes.size(); ++i) {
     const ShapeDesc& sh = desc_.shapes[i];
+    if (sh.material.type == MaterialDesc::Type::None) has_null_boundaries_ = true;
     if (sh.interior_medium >= 0) {
       inside_[i] = sh.interior_medium;
     } else if (sh.material.type == MaterialDesc::Type::Dielectric) {

@@ -28,6 +28,8 @@ class Scene {
   int outside_medium() const { return outside_; }
   /// Medium entered when a ray crosses shape i against its normal.
   int inside_medium(int shape) const { return inside_[static_cast<size_t>(shape)]; }
+  /// Whether any shape is an index-matched boundary (shadow rays must then walk through them).
+  bool has_null_boundaries() const { return has_null_boundaries_; }
   /// Offset used to leave a surface without hitting it again, mm.
   double ray_epsilon() const { return ray_eps_; }
 
@@ -40,6 +42,7 @@ class Scene {
   std::vector<int> inside_;
   int outside_ = 0;
   double ray_eps_ = 1e-5;
+  bool has_null_boundaries_ = false;
 };
 
 }  // namespace femto

@@ -65,6 +65,14 @@ bool VolPathIntegrator::connect(const Vec3& x, int m, const Vec3& wi, double dis
                                 double& time_ps, PathStats& stats) const {
   const auto& media = scene_.media();
   const double eps = scene_.ray_epsilon();
+  if (!scene_.has_null_boundaries()) {
+    // Every surface blocks: one occlusion query, and the segment stays in medium m.
+    if (dist > 2 * eps && scene_.geometry().occluded({x, wi}, 0.0, dist - eps)) return false;
+    const HomogeneousMedium& med = media[static_cast<size_t>(m)];
+    Tr = std::exp(-med.sigma_t() * dist);
+    time_ps = med.eta * dist / kSpeedOfLight;
+    return true;
+  }
   double optical_depth = 0.0, opl = 0.0;
   Ray ray{x, wi};
   double remaining = dist;
