@@ -151,9 +151,20 @@ SceneDesc furnace_scene(double rho, double Le, double sigma_s, double g) {
   return d;
 }
 
-void check_furnace(double sigma_s, double g) {
+void check_furnace(double sigma_s, double g, bool medium_in_sphere = false) {
   const double rho = 0.5, Le = 1.0, expected = Le / (1.0 - rho);
-  const SceneDesc desc = furnace_scene(rho, Le, sigma_s, g);
+  SceneDesc desc = furnace_scene(rho, Le, medium_in_sphere ? 0.0 : sigma_s, g);
+  if (medium_in_sphere) {
+    // The medium fills only an index-matched sphere beside the camera: shadow rays and paths
+    // cross its boundary and switch media.
+    desc.media.push_back(medium("ball", 0.0, sigma_s, g, 1.0));
+    ShapeDesc ball;
+    ball.type = ShapeDesc::Type::Sphere;
+    ball.center = {10, 5, -15};
+    ball.radius = 30;
+    ball.interior_medium = static_cast<int>(desc.media.size()) - 1;
+    desc.shapes.push_back(ball);
+  }
   const auto films = render_batches(desc, 64, 16);
   std::vector<double> means;
   double after = 0;
@@ -177,6 +188,7 @@ TEST_CASE("furnace: emissive diffuse box gives Le / (1 - rho) time-integrated", 
   SECTION("vacuum") { check_furnace(0.0, 0.0); }
   SECTION("non-absorbing forward-scattering medium") { check_furnace(0.02, 0.6); }
   SECTION("non-absorbing back-scattering medium") { check_furnace(0.05, -0.4); }
+  SECTION("medium inside an index-matched sphere") { check_furnace(0.08, 0.3, true); }
 }
 
 namespace {
