@@ -65,6 +65,7 @@ std::string utc_now() {
 }
 }  // namespace
 
+namespace {
 int cmd_render(const std::vector<std::string>& argv, const std::string& command_line) {
   cli::Args args("femto render", argv);
   std::string scene_path;
@@ -203,5 +204,8 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   }
   return 0;
 }
+}  // namespace
+
+FEMTO_COMMAND("render", "render a scene (the built-in default scene without one)", cmd_render);
 
 }  // namespace femto

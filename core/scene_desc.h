@@ -40,9 +40,45 @@ struct MaterialDesc {
   double eta = 1.5;              ///< dielectric: refractive index of the interior
 };
 
+/// How collision distances are sampled in a medium.
+enum class DistanceSampling {
+  Mfp,          ///< mean-free-path: p(s) = sigma_t(s) exp(-tau(s))
+  TimeUniform,  ///< exponential in optical path length with rate lambda (seed 000 Sec. 5.1)
+  Mis           ///< both, combined by multiple importance sampling
+};
+enum class MisHeuristic { Balance, Power };
+
+/// Affine placement applied after a volume's own index-to-world transform:
+/// scale, then rotate about x, y, z (degrees, in that order), then translate.
+struct TransformDesc {
+  Vec3 translate{0, 0, 0};
+  Vec3 rotate_deg{0, 0, 0};
+  Vec3 scale{1, 1, 1};
+};
+
+/// A heterogeneous medium read from an OpenVDB file.
+struct VdbMediumDesc {
+  std::string file;                    ///< path of the .vdb file (resolved against the scene)
+  std::string density_grid = "density";
+  double sigma_t_scale = 1.0;          ///< sigma_t = sigma_t_scale * density, 1/mm
+  double albedo = 0.9;                 ///< single-scattering albedo where no albedo grid is given
+  std::string albedo_grid;             ///< optional per-voxel albedo in [0, 1]
+  double eta = 1.0;                    ///< refractive index where no eta grid is given, and outside the grid
+  std::string eta_grid;                ///< optional per-voxel refractive index >= 1
+  enum class Interpolation { Nearest, Trilinear };
+  Interpolation interpolation = Interpolation::Nearest;
+  TransformDesc transform;
+};
+
 struct MediumDesc {
+  enum class Type { Homogeneous, Vdb };
   std::string name;
-  HomogeneousMedium medium;
+  Type type = Type::Homogeneous;
+  HomogeneousMedium medium;            ///< homogeneous coefficients; for VDB media only g is used
+  VdbMediumDesc vdb;                   ///< when type == Vdb
+  DistanceSampling sampling = DistanceSampling::Mfp;
+  double time_uniform_rate = 0.0;      ///< lambda, per mm of optical path length; 0 = automatic
+  MisHeuristic mis_heuristic = MisHeuristic::Balance;
 };
 
 struct ShapeDesc {
