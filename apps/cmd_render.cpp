@@ -30,6 +30,9 @@ const char* kRenderHelp =
     "  --seed S           random seed, integer >= 0; the same seed gives bit-identical output\n"
     "                     for any thread count (scene default: 1)\n"
     "  --threads N        worker threads, 0 = all cores (default 0)\n"
+    "  --distance-sampling S  collision-distance sampling in every medium, overriding the\n"
+    "                     scene: mfp (mean free path), time_uniform (exponential in optical\n"
+    "                     path length, uniform vertex times) or mis (both, combined by MIS)\n"
     "  --max-depth N      safety bound on scattering/bounce vertices per path; paths stopped by\n"
     "                     it are counted in render.json (scene default: 1000)\n"
     "  --out DIR          output folder, created if missing (default ./femto-out)\n"
@@ -71,6 +74,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   std::string scene_path;
   std::optional<int> spp, max_depth;
   std::optional<uint64_t> seed;
+  std::optional<DistanceSampling> sampling;
   int threads = 0;
   OutputOptions out;
   bool quiet = false;
@@ -86,6 +90,12 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       seed = args.uint_value();
     } else if (a == "--threads") {
       threads = static_cast<int>(args.int_value(0, 4096));
+    } else if (a == "--distance-sampling") {
+      const std::string v = args.value();
+      if (v == "mfp") sampling = DistanceSampling::Mfp;
+      else if (v == "time_uniform") sampling = DistanceSampling::TimeUniform;
+      else if (v == "mis") sampling = DistanceSampling::Mis;
+      else args.fail("expected mfp, time_uniform or mis", v);
     } else if (a == "--max-depth") {
       max_depth = static_cast<int>(args.int_value(1, 1000000));
     } else if (a == "--out") {
@@ -122,6 +132,8 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     scene_text = read_text(scene_path);
     desc = load_scene_file(scene_path);
   }
+  if (sampling)
+    for (MediumDesc& m : desc.media) m.sampling = *sampling;
   RenderOptions opt;
   opt.spp = spp.value_or(desc.integrator.spp);
   opt.seed = seed.value_or(desc.integrator.seed);
@@ -159,6 +171,22 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"integrator", "volpath (mean-free-path sampling, NEE + MIS)"},
                       {"reconstruction", "histogram"},
                       {"russian_roulette", false}};
+  nlohmann::json media = nlohmann::json::array();
+  {
+    const char* names[] = {"mfp", "time_uniform", "mis"};
+    for (size_t i = 0; i < scene.desc().media.size(); ++i) {
+      const MediumDesc& md = scene.desc().media[i];
+      const Medium& rm = scene.media()[i];
+      nlohmann::json e = {{"name", md.name},
+                          {"type", md.type == MediumDesc::Type::Vdb ? "vdb" : "homogeneous"},
+                          {"distance_sampling", names[static_cast<int>(md.sampling)]}};
+      if (md.sampling != DistanceSampling::Mfp) e["time_uniform_rate_per_mm_opl"] = rm.strategy.lambda;
+      if (md.sampling == DistanceSampling::Mis)
+        e["mis_heuristic"] = md.mis_heuristic == MisHeuristic::Power ? "power" : "balance";
+      media.push_back(e);
+    }
+  }
+  info["media"] = media;
   info["time_axis"] = {{"t_start_ps", axis.t_start_ps},
                        {"bin_width_ps", axis.bin_width_ps},
                        {"bins", axis.bins},

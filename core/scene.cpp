@@ -2,15 +2,35 @@
 
 #include <algorithm>
 
+#include "core/constants.h"
+#include "media/volume_data.h"
+
 namespace femto {
 
 Scene::Scene(SceneDesc desc)
     : desc_(std::move(desc)), geometry_(desc_), lights_(desc_), camera_(desc_.camera) {
-  for (const MediumDesc& m : desc_.media) media_.push_back(m.medium);
+  // Time-uniform sampling by default aims at about 3.5 vertices per path before the window end.
+  const double t_ref = desc_.time.t_end_ps() > 0 ? desc_.time.t_end_ps() : desc_.time.bin_width_ps * desc_.time.bins;
+  const double lambda_auto = 3.5 / (kSpeedOfLight * t_ref);
+  for (const MediumDesc& md : desc_.media) {
+    Medium m;
+    m.homogeneous = md.medium;
+    m.strategy.kind = md.sampling;
+    m.strategy.lambda = md.time_uniform_rate > 0 ? md.time_uniform_rate : lambda_auto;
+    m.strategy.heuristic = md.mis_heuristic;
+    if (md.type == MediumDesc::Type::Vdb) {
+      const VolumeData data = load_volume(md.vdb, desc_.source, "/media/" + md.name);
+      grids_.push_back(std::make_unique<GridMedium>(data, md.vdb));
+      m.type = Medium::Type::Grid;
+      m.grid = grids_.back().get();
+      m.homogeneous.eta = md.vdb.eta;
+    }
+    media_.push_back(m);
+  }
   if (desc_.global_medium >= 0) {
     outside_ = desc_.global_medium;
   } else {
-    media_.push_back(HomogeneousMedium{});  // vacuum
+    media_.push_back(Medium{});  // vacuum
     outside_ = static_cast<int>(media_.size()) - 1;
   }
   inside_.assign(desc_.shapes.size(), outside_);
@@ -20,8 +40,8 @@ Scene::Scene(SceneDesc desc)
     if (sh.interior_medium >= 0) {
       inside_[i] = sh.interior_medium;
     } else if (sh.material.type == MaterialDesc::Type::Dielectric) {
-      HomogeneousMedium clear;
-      clear.eta = sh.material.eta;
+      Medium clear;
+      clear.homogeneous.eta = sh.material.eta;
       media_.push_back(clear);
       inside_[i] = static_cast<int>(media_.size()) - 1;
     }

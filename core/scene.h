@@ -1,13 +1,15 @@
 #pragma once
 // The renderable scene built from a SceneDesc: geometry, lights, camera and the media of every
 // region (the space outside all shapes, and each closed shape's interior).
+#include <memory>
 #include <vector>
 
 #include "core/camera.h"
 #include "core/geometry.h"
 #include "core/lights.h"
 #include "core/scene_desc.h"
-#include "media/homogeneous.h"
+#include "media/grid_medium.h"
+#include "media/medium.h"
 
 namespace femto {
 
@@ -24,7 +26,7 @@ class Scene {
 
   /// Media of all regions; index outside_medium() is the space outside all shapes (vacuum by
   /// default). A dielectric shape without a named medium gets a clear medium of its own eta.
-  const std::vector<HomogeneousMedium>& media() const { return media_; }
+  const std::vector<Medium>& media() const { return media_; }
   int outside_medium() const { return outside_; }
   /// Medium entered when a ray crosses shape i against its normal.
   int inside_medium(int shape) const { return inside_[static_cast<size_t>(shape)]; }
@@ -38,7 +40,8 @@ class Scene {
   Geometry geometry_;
   LightSet lights_;
   Camera camera_;
-  std::vector<HomogeneousMedium> media_;
+  std::vector<Medium> media_;
+  std::vector<std::unique_ptr<GridMedium>> grids_;
   std::vector<int> inside_;
   int outside_ = 0;
   double ray_eps_ = 1e-5;

@@ -61,16 +61,92 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
   if (split.after > 0) acc.after += value * split.after;
 }
 
+VolPathIntegrator::MediumSample VolPathIntegrator::sample_medium(const Medium& med, const Ray& ray, double s_max,
+                                              Rng& rng) const {
+  MediumSample out;
+  DistanceEvent& ev = out.main;
+  if (!med.interacts()) {
+    ev.s = s_max;
+    ev.opl = med.homogeneous.eta * s_max;
+    return out;
+  }
+  const double u1 = rng.uniform();
+  if (med.type == Medium::Type::Homogeneous) {
+    const HomogeneousMedium& h = med.homogeneous;
+    if (med.strategy.kind == DistanceSampling::Mfp || !(h.sigma_s > 0)) {
+      // Closed form; a purely absorbing medium is integrated exactly instead of sampled.
+      const double s = h.sigma_s > 0 ? sample_exponential(h.sigma_t(), u1) : kInf;
+      ev.collided = s < s_max;
+      ev.s = ev.collided ? s : s_max;
+      ev.opl = h.eta * ev.s;
+      ev.sigma_t = h.sigma_t();
+      ev.eta = h.eta;
+      ev.weight = h.sigma_s > 0 ? 1.0 : std::exp(-h.sigma_t() * s_max);
+      return out;
+    }
+    ConstantSegments segments(h.sigma_t(), h.eta, s_max);
+    return finish_sample(segments, med.strategy, u1, rng);
+  }
+  GridMedium::Walker walker(*med.grid, ray, s_max);
+  return finish_sample(walker, med.strategy, u1, rng);
+}
+
+template <class Segments>
+VolPathIntegrator::MediumSample VolPathIntegrator::finish_sample(Segments& segments, const DistanceStrategy& st, double u1,
+                                              Rng& rng) const {
+  MediumSample out;
+  if (st.kind != DistanceSampling::Mis) {
+    out.main = sample_distance(segments, st, u1);
+    return out;
+  }
+  const DistancePair pair = sample_distance_mis(segments, st, u1, rng.uniform());
+  out.main = pair.mfp;
+  out.main_nee_weight = pair.mfp_nee_weight;
+  out.extra = pair.tu;
+  out.extra_nee_weight = pair.tu_nee_weight;
+  return out;
+}
+
+void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
+                                               const RGB& beta, double t, Rng& rng,
+                                               PixelAccumulator& acc, PathStats& stats) const {
+  const LightSet& lights = scene_.lights();
+  double pmf = 0;
+  const int li = lights.pick(rng.uniform(), pmf);
+  const double u1 = rng.uniform(), u2 = rng.uniform();
+  LightSample ls;
+  if (li < 0 || beta.is_black() || !lights.sample(li, x, u1, u2, ls)) return;
+  const double f = hg_eval(dot(d, ls.wi), g);
+  double Tr, dt;
+  if (!(f > 0) || !connect(x, m, ls.wi, ls.dist, Tr, dt, stats)) return;
+  const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, f);
+  const Light& L = lights.light(li);
+  deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(), beta * ls.Li * (f * Tr * w / (pmf * ls.pdf)), acc,
+          stats);
+}
+
+void VolPathIntegrator::segment_integrals(int m, const Ray& ray, double s, double& tau,
+                                          double& opl) const {
+  const Medium& med = scene_.media()[static_cast<size_t>(m)];
+  if (med.type == Medium::Type::Homogeneous) {
+    tau = med.homogeneous.sigma_t() * s;
+    opl = med.homogeneous.eta * s;
+    return;
+  }
+  GridMedium::Walker walker(*med.grid, ray, s);
+  integrate_segments(walker, tau, opl);
+}
+
 bool VolPathIntegrator::connect(const Vec3& x, int m, const Vec3& wi, double dist, double& Tr,
                                 double& time_ps, PathStats& stats) const {
-  const auto& media = scene_.media();
   const double eps = scene_.ray_epsilon();
   if (!scene_.has_null_boundaries()) {
     // Every surface blocks: one occlusion query, and the segment stays in medium m.
     if (dist > 2 * eps && scene_.geometry().occluded({x, wi}, 0.0, dist - eps)) return false;
-    const HomogeneousMedium& med = media[static_cast<size_t>(m)];
-    Tr = std::exp(-med.sigma_t() * dist);
-    time_ps = med.eta * dist / kSpeedOfLight;
+    double tau, opl;
+    segment_integrals(m, {x, wi}, dist, tau, opl);
+    Tr = std::exp(-tau);
+    time_ps = opl / kSpeedOfLight;
     return true;
   }
   double optical_depth = 0.0, opl = 0.0;
@@ -81,8 +157,10 @@ bool VolPathIntegrator::connect(const Vec3& x, int m, const Vec3& wi, double dis
     const double s_max = remaining - eps;
     const bool found = s_max > eps && scene_.geometry().intersect(ray, 0.0, s_max, hit);
     const double s = found ? hit.s : remaining;
-    optical_depth += media[static_cast<size_t>(m)].sigma_t() * s;
-    opl += media[static_cast<size_t>(m)].eta * s;
+    double tau_k, opl_k;
+    segment_integrals(m, ray, s, tau_k, opl_k);
+    optical_depth += tau_k;
+    opl += opl_k;
     if (!found) {
       Tr = std::exp(-optical_depth);
       time_ps = opl / kSpeedOfLight;
@@ -120,17 +198,24 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     SurfaceHit hit;
     const bool found = scene_.geometry().intersect(ray, 0.0, kInf, hit);
     const double s_surf = found ? hit.s : kInf;
-    const HomogeneousMedium& med = media[static_cast<size_t>(m)];
-    const double sigma_t = med.sigma_t();
-    // A purely absorbing medium is integrated exactly instead of sampled.
-    const double s_med = med.sigma_s > 0 ? sample_exponential(sigma_t, rng.uniform()) : kInf;
-    const double s = std::fmin(s_med, s_surf);
-    if (!std::isfinite(s)) break;  // escaped to infinity
-    if (!(med.sigma_s > 0) && sigma_t > 0) beta *= std::exp(-sigma_t * s);
-    if (!(unwarp_ && on_camera_segment)) t += med.eta * s / kSpeedOfLight;
+    const Medium& med = media[static_cast<size_t>(m)];
+    const MediumSample ms = sample_medium(med, ray, s_surf, rng);
+    const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
+    if (ms.extra.collided && depth < max_depth_) {
+      // The time-uniform collision of MIS: next-event estimation only (the path goes on from
+      // the mean-free-path collision).
+      const Vec3 x2 = ray.at(ms.extra.s);
+      const double albedo2 = med.type == Medium::Type::Grid ? med.grid->albedo_at(x2) : med.homogeneous.albedo();
+      estimate_direct_medium(x2, m, ray.d, med.g(), beta * (albedo2 * ms.extra_nee_weight),
+                             t + ms.extra.opl * t_dropped, rng, acc, stats);
+    }
+    const DistanceEvent& ev = ms.main;
+    if (!ev.collided && !found) break;  // escaped to infinity
+    beta *= ev.weight;
+    t += ev.opl * t_dropped;
     if (t > t_cut_) break;
 
-    if (s_med < s_surf) {
+    if (ev.collided) {
       // Real collision: absorb by weighting with the single-scattering albedo.
       on_camera_segment = false;
       ++stats.medium_events;
@@ -139,26 +224,12 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
         break;
       }
       ++depth;
-      beta *= med.albedo();
+      const Vec3 x = ray.at(ev.s);
+      beta *= med.type == Medium::Type::Grid ? med.grid->albedo_at(x) : med.homogeneous.albedo();
       if (beta.is_black()) break;
-      const Vec3 x = ray.at(s_med);
-      // Next-event estimation to one light.
-      double pmf = 0;
-      const int li = lights.pick(rng.uniform(), pmf);
-      const double u1 = rng.uniform(), u2 = rng.uniform();
-      LightSample ls;
-      if (li >= 0 && lights.sample(li, x, u1, u2, ls)) {
-        const double f = hg_eval(dot(ray.d, ls.wi), med.g);
-        double Tr, dt;
-        if (f > 0 && connect(x, m, ls.wi, ls.dist, Tr, dt, stats)) {
-          const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, f);
-          const Light& L = lights.light(li);
-          deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(),
-                  beta * ls.Li * (f * Tr * w / (pmf * ls.pdf)), acc, stats);
-        }
-      }
+      estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t, rng, acc, stats);
       // Phase sampling: HG is sampled exactly, so the weight f / pdf is 1.
-      const PhaseSample ps = hg_sample(ray.d, med.g, rng.uniform(), rng.uniform());
+      const PhaseSample ps = hg_sample(ray.d, med.g(), rng.uniform(), rng.uniform());
       prev_pdf = ps.value;
       specular = false;
       prev_p = x;
@@ -232,7 +303,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
         break;
       }
       case MaterialDesc::Type::Dielectric: {
-        const double eta_out = media[static_cast<size_t>(scene_.outside_medium())].eta;
+        const double eta_out = media[static_cast<size_t>(scene_.outside_medium())].eta_at(hit.p);
         const double eta_in = sh.material.eta;
         const double eta = front ? eta_in / eta_out : eta_out / eta_in;  // eta_t / eta_i
         const double cos_i = dot(wo, ns);

@@ -10,6 +10,7 @@
 #include "core/rng.h"
 #include "core/scene.h"
 #include "core/temporal_filter.h"
+#include "samplers/medium_distance.h"
 
 namespace femto {
 
@@ -51,6 +52,23 @@ class VolPathIntegrator {
   /// surface blocks it.
   bool connect(const Vec3& x, int m, const Vec3& wi, double dist, double& Tr, double& time_ps,
                PathStats& stats) const;
+  /// Collision sampling on one ray segment: `main` continues the path; under MIS `extra` is the
+  /// time-uniform collision, used for next-event estimation only.
+  struct MediumSample {
+    DistanceEvent main;
+    double main_nee_weight = 1.0;  ///< extra factor for next-event estimation at `main`
+    DistanceEvent extra;
+    double extra_nee_weight = 0.0;
+  };
+  /// Next collision in `med` along `ray` before s_max (a surface, or infinity).
+  MediumSample sample_medium(const Medium& med, const Ray& ray, double s_max, Rng& rng) const;
+  template <class Segments>
+  MediumSample finish_sample(Segments& segments, const DistanceStrategy& st, double u1, Rng& rng) const;
+  /// Next-event estimation from a medium point x reached along direction d with throughput beta.
+  void estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g, const RGB& beta, double t,
+                              Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
+  /// Optical depth and optical path length of [0, s] along `ray` inside medium m.
+  void segment_integrals(int m, const Ray& ray, double s, double& tau, double& opl) const;
   void deposit(double t_ps, double sigma_ps, const RGB& value, PixelAccumulator& acc,
                PathStats& stats) const;
 
