@@ -1,0 +1,109 @@
+#include "core/diffusion/simulate.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/diffusion/models.h"
+#include "core/progress.h"
+#include "core/sampling.h"
+
+namespace femto::diffusion {
+
+namespace {
+constexpr uint64_t kBatch = 4096;  // photons per batch: the unit of work and of ordered reduction
+
+void trace_photon(const PhotonTransport& transport, double t_end, Rng rng, PhotonTally& tally) {
+  Photon p;
+  const double u1 = rng.uniform(), u2 = rng.uniform();
+  p.d = sample_uniform_sphere(u1, u2);
+  while (p.alive && p.t < t_end) tally.add(transport.advance(p, rng));
+}
+}  // namespace
+
+DiffusionResult simulate(const DiffusionSetup& setup) {
+  return simulate(setup, InfiniteHomogeneous(setup.medium, setup.absorption));
+}
+
+DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& transport) {
+  const auto start = std::chrono::steady_clock::now();
+  const Grid& grid = setup.grid;
+  const TallyLayout layout{grid.shells, grid.time.bins};
+  const uint64_t N = setup.photons;
+  const int threads = setup.threads > 0 ? setup.threads : tbb::info::default_concurrency();
+  const uint64_t batches = (N + kBatch - 1) / kBatch;
+  // Batches in flight per round: two per thread, within 1 GiB of partial sums.
+  const size_t slot_bytes = 2 * sizeof(double) * layout.size();
+  const size_t slots = std::max<size_t>(
+      1, std::min<size_t>(2 * static_cast<size_t>(threads), (size_t{1} << 30) / slot_bytes));
+
+  TallySums total;
+  total.reset(layout.size());
+  std::vector<TallySums> partial(slots);
+  tbb::enumerable_thread_specific<PhotonTally> tallies([&] { return PhotonTally(grid); });
+  Progress progress(N, "diffusion", setup.quiet);
+  tbb::task_arena arena(threads);
+  for (uint64_t first = 0; first < batches; first += slots) {
+    const size_t count = static_cast<size_t>(std::min<uint64_t>(slots, batches - first));
+    arena.execute([&] {
+      tbb::parallel_for(size_t{0}, count, [&](size_t k) {
+        PhotonTally& tally = tallies.local();
+        TallySums& sums = partial[k];
+        sums.reset(layout.size());
+        const uint64_t p0 = (first + k) * kBatch, p1 = std::min(N, p0 + kBatch);
+        for (uint64_t i = p0; i < p1; ++i) {
+          trace_photon(transport, grid.time.t_end_ps(), Rng::for_sample(setup.seed, i, 0), tally);
+          tally.end_photon(sums);
+        }
+        progress.add(p1 - p0);
+      });
+    });
+    for (size_t k = 0; k < count; ++k) total.add(partial[k]);  // batch order: thread-independent
+  }
+  progress.finish();
+
+  DiffusionResult r;
+  r.grid = grid;
+  r.photons = total.photons;
+  r.segments = total.segments;
+  r.threads = threads;
+  const double n = static_cast<double>(std::max<uint64_t>(total.photons, 1));
+  // Mean and standard error of the per-photon integrals at index i, times scale.
+  auto estimate = [&](size_t i, double scale, double& mean, double& err) {
+    const double m = total.sum[i] / n;
+    const double var = n > 1 ? std::max(0.0, (total.sum2[i] - n * m * m) / (n - 1)) : 0.0;
+    mean = m * scale;
+    err = std::sqrt(var / n) * scale;
+  };
+  const size_t bins = static_cast<size_t>(grid.time.bins),
+               shells = static_cast<size_t>(grid.shells);
+  r.u.resize(bins * shells), r.u_err.resize(bins * shells);
+  for (auto* v : {&r.energy, &r.energy_err, &r.r2, &r.r2_err, &r.r4, &r.r4_err, &r.unscattered,
+                  &r.unscattered_err, &r.single, &r.single_err})
+    v->resize(bins);
+  const double dt = grid.time.bin_width_ps;
+  for (int j = 0; j < grid.time.bins; ++j) {
+    for (int i = 0; i < grid.shells; ++i) {
+      const size_t c = layout.cell(i, j);
+      estimate(c, 1 / (grid.shell_volume(i) * dt), r.u[c], r.u_err[c]);
+    }
+    const double t0 = grid.time.bin_start_ps(j);
+    const double exact =
+        survival_integral(setup.medium, t0, t0 + dt);  // expected energy-time in the bin
+    estimate(layout.slot(Quantity::Energy, j), 1 / dt, r.energy[j], r.energy_err[j]);
+    estimate(layout.slot(Quantity::R2, j), 1 / exact, r.r2[j], r.r2_err[j]);
+    estimate(layout.slot(Quantity::R4, j), 1 / exact, r.r4[j], r.r4_err[j]);
+    estimate(layout.slot(Quantity::Unscattered, j), 1 / exact, r.unscattered[j],
+             r.unscattered_err[j]);
+    estimate(layout.slot(Quantity::Single, j), 1 / exact, r.single[j], r.single_err[j]);
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+}  // namespace femto::diffusion

@@ -1,0 +1,52 @@
+#pragma once
+// Monte Carlo of an isotropic delta-pulse point source at the origin at t = 0: exact
+// track-length tallies of energy density, energy, <r^2>, <r^4> and low scattering orders over
+// radial shells and time bins, with per-photon standard errors. Multi-threaded (oneTBB) and
+// bit-identical for any thread count: photon i always uses Rng::for_sample(seed, i, 0), photons
+// are summed in order within fixed batches and batches are reduced in order.
+#include <cstdint>
+#include <vector>
+
+#include "core/diffusion/tally.h"
+#include "core/diffusion/transport.h"
+#include "media/homogeneous.h"
+
+namespace femto::diffusion {
+
+struct DiffusionSetup {
+  HomogeneousMedium medium;
+  Absorption absorption = Absorption::Weighted;
+  Grid grid;
+  uint64_t photons = 1000000;
+  uint64_t seed = 1;
+  int threads = 0;    ///< 0 = all cores
+  bool quiet = true;  ///< no progress on stderr
+};
+
+/// Means and standard errors per unit emitted energy. Per-bin values are averages over the bin.
+struct DiffusionResult {
+  Grid grid;
+  /// Energy density averaged over shell and bin, 1/mm^3, index bin * shells + shell.
+  std::vector<double> u, u_err;
+  /// Energy in the medium (all radii).
+  std::vector<double> energy, energy_err;
+  /// int r^2 u dV and int r^4 u dV divided by the exact mean energy exp(-sigma_a v t) (both
+  /// averaged over the bin): unbiased estimates of <r^2> (mm^2) and <r^4> (mm^4) in both
+  /// absorption modes, since absorption does not change the normalised distribution.
+  std::vector<double> r2, r2_err, r4, r4_err;
+  /// Fractions of the (exact mean) energy present that are unscattered and singly scattered.
+  std::vector<double> unscattered, unscattered_err, single, single_err;
+  uint64_t photons = 0, segments = 0;
+  int threads = 0;
+  double seconds = 0;
+
+  size_t cell(int shell, int bin) const { return static_cast<size_t>(bin) * grid.shells + shell; }
+};
+
+/// Runs setup.photons photons through `transport` (the source sits at the origin at t = 0);
+/// per-bin normalisations use setup.medium's absorption.
+DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& transport);
+/// The infinite homogeneous medium setup.medium with setup.absorption.
+DiffusionResult simulate(const DiffusionSetup& setup);
+
+}  // namespace femto::diffusion

@@ -1,0 +1,81 @@
+#pragma once
+// Exact track-length tallies over radial shells and time bins: every straight segment of a
+// photon's path adds, to each (shell, bin) cell, the time it spends there weighted by its
+// energy, and per bin the time integrals of energy, r^2 and r^4. Nothing is sampled: the
+// estimators are unbiased and their only noise is that of the paths themselves.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/diffusion/transport.h"
+#include "core/time_axis.h"
+
+namespace femto::diffusion {
+
+/// Radial shells [i dr, (i + 1) dr), i < shells, around the source at the origin, and a time axis.
+struct Grid {
+  TimeAxis time;
+  int shells = 1;
+  double dr = 1;  ///< mm
+
+  double r_max() const { return shells * dr; }
+  double shell_volume(int i) const;  ///< mm^3
+  double shell_center(int i) const { return (i + 0.5) * dr; }
+};
+
+/// Per-bin quantities tallied next to the (shell, bin) cells.
+enum class Quantity { Energy, R2, R4, Unscattered, Single };
+constexpr int kQuantities = 5;
+
+/// Where each per-photon integral lives in a tally vector: first the cells
+/// (bin * shells + shell: time integral of the weight in the cell, ps), then per quantity and
+/// bin: integral over the bin of w, w r^2, w r^4 (ps, mm^2 ps, mm^4 ps) and of w restricted to
+/// unscattered and to singly scattered light.
+struct TallyLayout {
+  int shells = 1, bins = 1;
+  size_t cell(int shell, int bin) const { return static_cast<size_t>(bin) * shells + shell; }
+  size_t slot(Quantity q, int bin) const {
+    return static_cast<size_t>(shells) * bins + static_cast<size_t>(q) * bins + bin;
+  }
+  size_t size() const { return static_cast<size_t>(shells + kQuantities) * bins; }
+};
+
+/// Sums over photons of the per-photon integrals and of their squares (for per-photon variance).
+struct TallySums {
+  std::vector<double> sum, sum2;
+  uint64_t photons = 0, segments = 0;
+  void reset(size_t n);
+  /// Elementwise sum; calling it in a fixed order makes the rounding independent of threads.
+  void add(const TallySums& other);
+};
+
+/// Accumulates one photon at a time (sparse: only touched entries are flushed).
+class PhotonTally {
+ public:
+  explicit PhotonTally(const Grid& grid);
+  const TallyLayout& layout() const { return layout_; }
+  /// Adds the part of the segment inside the time window.
+  void add(const Segment& s);
+  /// Adds this photon's integrals and their squares to `into` and starts the next photon.
+  void end_photon(TallySums& into);
+
+ private:
+  void put(size_t i, double x);
+  void bin_piece(const Segment& s, int bin, double tau1, double tau2);
+
+  Grid grid_;
+  TallyLayout layout_;
+  std::vector<double> value_;
+  std::vector<uint64_t> stamp_;  // photon that last touched an entry
+  std::vector<size_t> touched_;
+  uint64_t photon_ = 1, segments_ = 0;
+};
+
+/// J[n] = integral over s in [0, h] of exp(-k s) s^n, n = 0..4, for k >= 0 and h >= 0: a power
+/// series when k h < 2, the closed-form recurrence otherwise (relative error ~1e-15).
+void exp_moments(double k, double h, double J[5]);
+
+/// Integral over tau in [a, b] of exp(-k tau), stable for k b small (k >= 0).
+double exp_integral(double k, double a, double b);
+
+}  // namespace femto::diffusion
