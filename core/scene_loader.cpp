@@ -642,6 +642,8 @@ class Loader {
       m.sampling = v == "mfp"            ? DistanceSampling::Mfp
                    : v == "time_uniform" ? DistanceSampling::TimeUniform
                                          : DistanceSampling::Mis;
+    } else {
+      m.sampling = DistanceSampling::Mis;  // the default for scene files (docs/scene-format.md)
     }
     const std::string uses =
         std::string("; this medium uses \"") +

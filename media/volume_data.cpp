@@ -144,7 +144,9 @@ class VolumeLoader {
       check_background(u);
       box.expand(u.grid->evalActiveVoxelBoundingBox());
     }
-    if (density.evalActiveVoxelBoundingBox().empty())
+    // An empty density is fine when an eta grid gives the medium a shape (a pure index medium).
+    const bool has_eta = std::any_of(used.begin(), used.end(), [](const Used& u) { return u.role == Role::Eta; });
+    if (density.evalActiveVoxelBoundingBox().empty() && (!has_eta || box.empty()))
       fail(used[0], "grid '" + used[0].name + "' has no active voxels, so the medium is empty");
     out.active_voxels = density.activeVoxelCount();
 
