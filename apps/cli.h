@@ -36,6 +36,8 @@ class Args {
 };
 
 std::string format_bytes(uint64_t bytes);
+/// Current UTC time as ISO 8601, e.g. "2026-11-22T04:30:00Z" (for run records).
+std::string utc_now();
 uint64_t physical_memory_bytes();
 
 }  // namespace femto::cli

@@ -59,14 +59,6 @@ const char* kDiffusionHelp =
     "Outputs: fluence.csv, moments.csv, models.csv, fluence_models.csv, summary.json,\n"
     "fluence.png and distance.png (see docs/diffusion.md).\n";
 
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
 
 // A number from the current flag's value, with a message naming the flag and the value.
 double number(cli::Args& args, double lo, double hi, bool lo_open, bool hi_open,
@@ -213,7 +205,7 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
   opt.run = {{"femto_version", FEMTO_VERSION},
              {"femto_build", FEMTO_GIT_DESCRIBE},
              {"command", command_line},
-             {"date_utc", utc_now()}};
+             {"date_utc", cli::utc_now()}};
   const std::vector<std::string> files = diffusion::write_report(setup, result, analysis, opt);
 
   if (!quiet) {

@@ -58,14 +58,6 @@ std::string read_text(const std::string& path) {
   return ss.str();
 }
 
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
 }  // namespace
 
 namespace {
@@ -161,7 +153,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   info["femto_version"] = FEMTO_VERSION;
   info["femto_build"] = FEMTO_GIT_DESCRIBE;
   info["command"] = command_line;
-  info["date_utc"] = utc_now();
+  info["date_utc"] = cli::utc_now();
   info["scene"] = {{"source", scene.desc().source},
                    {"json", nlohmann::json::parse(scene_text, nullptr, false)}};
   info["settings"] = {{"spp", opt.spp},
