@@ -6,6 +6,7 @@
 #include <ctime>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -15,6 +16,9 @@
 #include "core/diffusion/report.h"
 #include "core/error.h"
 #include "core/progress.h"
+#include "core/scene_loader.h"
+#include "media/grid_medium.h"
+#include "media/volume_data.h"
 #include "femto_version.h"
 
 namespace femto {
@@ -37,6 +41,12 @@ const char* kDiffusionHelp =
     "  --eta X            refractive index, >= 1; light travels at c / eta (default 1)\n"
     "  --absorption MODE  weighted (default: weight exp(-sigma_a v t), energy exact by\n"
     "                     construction) or analog (absorbing collisions end photons)\n"
+    "Source inside a scene's medium (instead of the flags above):\n"
+    "  --scene FILE       a scene file; its shapes are ignored, the medium fills space\n"
+    "  --medium NAME      the medium to use (default: the scene's \"medium\", around everything)\n"
+    "  --at X,Y,Z         source position in the scene, mm (required with --scene). Voxel (vdb)\n"
+    "                     media use analog absorption and the measured energy to normalise\n"
+    "                     the moments; the models use the coefficients at the source point\n"
     "Tallies:\n"
     "  --t-start T        window start, ps >= 0 (default 0)\n"
     "  --t-end T          window end, ps (default 40 mean free times)\n"
@@ -86,7 +96,9 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
   int t_bins = 200, r_bins = 120;
   std::string out_dir = "femto-diffusion", plot_text;
   std::vector<double> plot_times;
-  bool quiet = false;
+  bool quiet = false, absorption_given = false;
+  std::string scene_path, medium_name;
+  std::optional<Vec3> at;
   while (!args.done()) {
     const std::string a = args.next();
     if (a == "--help" || a == "-h") {
@@ -100,7 +112,24 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
       setup.medium.g = number(args, -1, 1, true, true, "in (-1, 1)");
     } else if (a == "--eta") {
       setup.medium.eta = number(args, 1, 100, false, false, "in [1, 100]");
+    } else if (a == "--scene") {
+      scene_path = args.value();
+    } else if (a == "--medium") {
+      medium_name = args.value();
+    } else if (a == "--at") {
+      const std::string v = args.value();
+      std::stringstream ss(v);
+      std::vector<double> xyz;
+      for (std::string item; std::getline(ss, item, ',');) {
+        char* end = nullptr;
+        const double x = std::strtod(item.c_str(), &end);
+        if (item.empty() || *end != '\0' || !std::isfinite(x)) args.fail("expected X,Y,Z in mm", v);
+        xyz.push_back(x);
+      }
+      if (xyz.size() != 3) args.fail("expected X,Y,Z in mm", v);
+      at = Vec3(xyz[0], xyz[1], xyz[2]);
     } else if (a == "--absorption") {
+      absorption_given = true;
       const std::string v = args.value();
       if (v == "weighted")
         setup.absorption = diffusion::Absorption::Weighted;
@@ -154,6 +183,45 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
     }
   }
 
+  // A source inside a scene's medium: a homogeneous medium is used as an infinite one, a voxel
+  // medium through VoxelTransport around the source point.
+  std::unique_ptr<GridMedium> grid;
+  std::unique_ptr<diffusion::PhotonTransport> transport;
+  nlohmann::json source = {{"kind", "infinite homogeneous medium"}};
+  if (!scene_path.empty() || at || !medium_name.empty()) {
+    if (scene_path.empty()) throw InputError("femto diffusion: --at and --medium need --scene");
+    if (!at) throw InputError("femto diffusion: --at: required with --scene (the source position)");
+    const SceneDesc scene = load_scene_file(scene_path);
+    int mi = scene.global_medium;
+    if (!medium_name.empty()) {
+      mi = -1;
+      for (size_t i = 0; i < scene.media.size(); ++i)
+        if (scene.media[i].name == medium_name) mi = static_cast<int>(i);
+      if (mi < 0) throw InputError("femto diffusion: --medium: no medium named '" + medium_name + "' in " + scene_path);
+    }
+    if (mi < 0)
+      throw InputError("femto diffusion: --medium: " + scene_path + " has no \"medium\" around everything; name one");
+    const MediumDesc& md = scene.media[static_cast<size_t>(mi)];
+    source = {{"kind", "scene medium"}, {"scene", scene_path}, {"medium", md.name},
+              {"position_mm", {at->x, at->y, at->z}}, {"shapes", "ignored: the medium fills space"}};
+    if (md.type == MediumDesc::Type::Homogeneous) {
+      setup.medium = md.medium;
+    } else {
+      if (absorption_given && setup.absorption == diffusion::Absorption::Weighted)
+        throw InputError("femto diffusion: --absorption: 'weighted' needs a homogeneous medium; voxel media use analog (got 'weighted')");
+      const VolumeData data = load_volume(md.vdb, scene_path, medium_where(md.name));
+      grid = std::make_unique<GridMedium>(data, md.vdb);
+      transport = std::make_unique<diffusion::VoxelTransport>(*grid, md.medium.g, *at);
+      setup.absorption = diffusion::Absorption::Analog;
+      setup.normalise_by_energy = true;
+      // The models and the default window use the medium at the source point.
+      const double st = grid->sigma_t_at(*at), albedo = grid->albedo_at(*at);
+      setup.medium = HomogeneousMedium{(1 - albedo) * st, albedo * st, md.medium.g, grid->eta_at(*at)};
+      source["local_coefficients"] = {{"sigma_a", setup.medium.sigma_a}, {"sigma_s", setup.medium.sigma_s},
+                                      {"g", setup.medium.g}, {"eta", setup.medium.eta}};
+    }
+  }
+
   // Cross-flag checks, all before anything is written.
   const diffusion::Scales sc = diffusion::scales_of(setup.medium);
   auto fail = [](const std::string& flag, const std::string& problem, double got) {
@@ -197,7 +265,8 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
                  static_cast<unsigned long long>(setup.photons), t_bins, *t_end, r_bins, *r_max,
                  setup.medium.sigma_s * sc.v * *t_end);
 
-  const diffusion::DiffusionResult result = diffusion::simulate(setup);
+  const diffusion::DiffusionResult result =
+      transport ? diffusion::simulate(setup, *transport) : diffusion::simulate(setup);
   const diffusion::Analysis analysis = diffusion::analyse(setup, result, threshold);
   diffusion::ReportOptions opt;
   opt.dir = out_dir;
@@ -205,7 +274,8 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
   opt.run = {{"femto_version", FEMTO_VERSION},
              {"femto_build", FEMTO_GIT_DESCRIBE},
              {"command", command_line},
-             {"date_utc", cli::utc_now()}};
+             {"date_utc", cli::utc_now()},
+             {"source", source}};
   const std::vector<std::string> files = diffusion::write_report(setup, result, analysis, opt);
 
   if (!quiet) {
@@ -234,7 +304,7 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
 }
 }  // namespace
 
-FEMTO_COMMAND("diffusion", "pulse in an infinite medium: when does the wavefront become Gaussian?",
+FEMTO_COMMAND("diffusion", "pulse in a medium: when does the wavefront become Gaussian?",
               cmd_diffusion);
 
 }  // namespace femto

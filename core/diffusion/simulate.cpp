@@ -93,14 +93,19 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
       estimate(c, 1 / (grid.shell_volume(i) * dt), r.u[c], r.u_err[c]);
     }
     const double t0 = grid.time.bin_start_ps(j);
-    const double exact =
-        survival_integral(setup.medium, t0, t0 + dt);  // expected energy-time in the bin
     estimate(layout.slot(Quantity::Energy, j), 1 / dt, r.energy[j], r.energy_err[j]);
-    estimate(layout.slot(Quantity::R2, j), 1 / exact, r.r2[j], r.r2_err[j]);
-    estimate(layout.slot(Quantity::R4, j), 1 / exact, r.r4[j], r.r4_err[j]);
-    estimate(layout.slot(Quantity::Unscattered, j), 1 / exact, r.unscattered[j],
-             r.unscattered_err[j]);
-    estimate(layout.slot(Quantity::Single, j), 1 / exact, r.single[j], r.single_err[j]);
+    // Expected energy-time in the bin: exact for a homogeneous medium, else the MC estimate.
+    const double exact = setup.normalise_by_energy ? r.energy[j] * dt
+                                                   : survival_integral(setup.medium, t0, t0 + dt);
+    const double rel_den = setup.normalise_by_energy && r.energy[j] > 0 ? r.energy_err[j] / r.energy[j] : 0.0;
+    auto ratio = [&](Quantity q, double& mean, double& err) {
+      estimate(layout.slot(q, j), exact > 0 ? 1 / exact : 0.0, mean, err);
+      if (rel_den > 0 && mean != 0) err = std::hypot(err, std::abs(mean) * rel_den);
+    };
+    ratio(Quantity::R2, r.r2[j], r.r2_err[j]);
+    ratio(Quantity::R4, r.r4[j], r.r4_err[j]);
+    ratio(Quantity::Unscattered, r.unscattered[j], r.unscattered_err[j]);
+    ratio(Quantity::Single, r.single[j], r.single_err[j]);
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;

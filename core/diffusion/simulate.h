@@ -21,6 +21,10 @@ struct DiffusionSetup {
   uint64_t seed = 1;
   int threads = 0;    ///< 0 = all cores
   bool quiet = true;  ///< no progress on stderr
+  /// Normalise <r^2>, <r^4> and the scattering-order fractions by the Monte Carlo energy in each
+  /// bin instead of the exact exp(-sigma_a v t) of `medium` (for heterogeneous media, where no
+  /// closed form exists; a ratio estimator, consistent, with errors combined as independent).
+  bool normalise_by_energy = false;
 };
 
 /// Means and standard errors per unit emitted energy. Per-bin values are averages over the bin.

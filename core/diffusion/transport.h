@@ -1,10 +1,11 @@
 #pragma once
 // Photon transport for `femto diffusion`. A medium advances a photon one straight segment at a
 // time; the tallies (core/diffusion/tally.h) only see segments, never how flights are sampled.
-// Implemented: an infinite homogeneous medium. Planned: a point source inside a scene's
-// (heterogeneous) medium behind the same interface, splitting segments where eta changes.
+// Implemented: an infinite homogeneous medium, and a scene's voxel medium around a source point
+// (segments split at every cell, where sigma_t and eta may change).
 #include "core/rng.h"
 #include "core/vec3.h"
+#include "media/grid_medium.h"
 #include "media/homogeneous.h"
 
 namespace femto::diffusion {
@@ -17,6 +18,7 @@ struct Photon {
   double w = 1;         ///< energy carried, in units of the emitted energy
   int scatterings = 0;  ///< scattering events so far
   bool alive = true;    ///< false once absorbed or gone for good
+  double tau_left = -1; ///< optical depth left to the next collision (voxel media); < 0: draw anew
 };
 
 /// A straight piece of a path at constant speed: position x0 + d v tau and weight
@@ -56,6 +58,22 @@ class InfiniteHomogeneous final : public PhotonTransport {
   HomogeneousMedium m_;
   Absorption absorption_;
   double v_;
+};
+
+/// A voxel medium around a source at world point `origin` (photon positions are relative to it).
+/// Analog absorption: collisions at sigma_t, absorbed with probability 1 - albedo. Each call
+/// advances to the next collision or to the end of the current cell (constant speed c / eta
+/// there; with trilinear data the piece's mean speed, so that its end time is exact). Shapes of
+/// the scene are ignored: the medium is taken to fill space (empty outside its grid).
+class VoxelTransport final : public PhotonTransport {
+ public:
+  VoxelTransport(const GridMedium& grid, double g, const Vec3& origin);
+  Segment advance(Photon& p, Rng& rng) const override;
+
+ private:
+  const GridMedium& grid_;
+  double g_;
+  Vec3 origin_;
 };
 
 }  // namespace femto::diffusion
