@@ -19,7 +19,7 @@ Scene::Scene(SceneDesc desc)
     m.strategy.lambda = md.time_uniform_rate > 0 ? md.time_uniform_rate : lambda_auto;
     m.strategy.heuristic = md.mis_heuristic;
     if (md.type == MediumDesc::Type::Vdb) {
-      const VolumeData data = load_volume(md.vdb, desc_.source, "/media/" + md.name);
+      const VolumeData data = load_volume(md.vdb, desc_.source, medium_where(md.name));
       grids_.push_back(std::make_unique<GridMedium>(data, md.vdb));
       m.type = Medium::Type::Grid;
       m.grid = grids_.back().get();

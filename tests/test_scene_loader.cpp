@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -523,6 +524,168 @@ TEST_CASE("scene loader: JSON syntax errors give line and column", "[scene_loade
              Contains("test.json: line 3, column 15: ") && Contains("syntax error"));
   CHECK_THAT(error_of_text("{\n  \"camera\": {\n"), Contains("test.json: line 3, column 1: "));
   CHECK_THAT(error_of_text(""), Contains("test.json: line 1, column 1: "));
+}
+
+// A VDB medium named "cloud" (the loader only checks that its file exists; it never parses it).
+Json vdb_scene(const Json& cloud) {
+  write_file("cloud.vdb", "not parsed by the loader");
+  Json j = base_scene();
+  j["media"]["cloud"] = cloud;
+  j["shapes"].push_back(Json::parse(
+      R"({"type": "box", "min": [20, 0, 0], "max": [30, 10, 10], "medium": "cloud"})"));
+  return j;
+}
+
+Json minimal_vdb() {
+  return Json::parse(R"({"type": "vdb", "file": "cloud.vdb", "sigma_t_scale": 0.5})");
+}
+
+TEST_CASE("scene loader: vdb media and distance-sampling keys", "[scene_loader]") {
+  Json j = vdb_scene(Json::parse(R"({
+    "type": "vdb", "file": "cloud.vdb", "density_grid": "smoke", "sigma_t_scale": 0.5,
+    "albedo_grid": "a", "eta_grid": "e", "eta": 1.2, "g": 0.4, "interpolation": "trilinear",
+    "transform": {"translate": [1, 2, 3], "rotate": [0, 90, 0], "scale": 2},
+    "distance_sampling": "mis", "time_uniform_rate": 0.25, "mis_heuristic": "power"})"));
+  j["media"]["fog"]["distance_sampling"] = "time_uniform";
+  j["media"]["fog"]["time_uniform_rate"] = 3;
+  j["media"]["air"]["distance_sampling"] = "mfp";
+  j["medium"] = "cloud";
+  const SceneDesc s = load(j);
+  REQUIRE(s.media.size() == 3);
+  const femto::MediumDesc& m = s.media[2];
+  CHECK(s.global_medium == 2);
+  CHECK(s.shapes.back().interior_medium == 2);
+  CHECK(m.type == femto::MediumDesc::Type::Vdb);
+  CHECK(m.vdb.file == (temp_dir() / "cloud.vdb").lexically_normal().string());
+  CHECK(m.vdb.density_grid == "smoke");
+  CHECK(m.vdb.sigma_t_scale == 0.5);
+  CHECK(m.vdb.albedo_grid == "a");
+  CHECK(m.vdb.eta_grid == "e");
+  CHECK(m.vdb.eta == 1.2);
+  CHECK(m.medium.eta == 1.2);
+  CHECK(m.medium.g == 0.4);
+  CHECK(m.vdb.interpolation == femto::VdbMediumDesc::Interpolation::Trilinear);
+  CHECK(m.vdb.transform.translate.z == 3);
+  CHECK(m.vdb.transform.rotate_deg.y == 90);
+  CHECK(m.vdb.transform.scale.x == 2);
+  CHECK(m.vdb.transform.scale.z == 2);
+  CHECK(m.sampling == femto::DistanceSampling::Mis);
+  CHECK(m.time_uniform_rate == 0.25);
+  CHECK(m.mis_heuristic == femto::MisHeuristic::Power);
+  CHECK(s.media[0].type == femto::MediumDesc::Type::Homogeneous);
+  CHECK(s.media[0].sampling == femto::DistanceSampling::TimeUniform);
+  CHECK(s.media[0].time_uniform_rate == 3);
+  CHECK(s.media[1].sampling == femto::DistanceSampling::Mfp);
+
+  // Defaults of a minimal vdb medium.
+  const SceneDesc d = load(vdb_scene(minimal_vdb()));
+  const femto::MediumDesc& md = d.media[2];
+  CHECK(md.vdb.density_grid == "density");
+  CHECK(md.vdb.albedo == 0.9);
+  CHECK(md.vdb.albedo_grid.empty());
+  CHECK(md.vdb.eta == 1.0);
+  CHECK(md.vdb.eta_grid.empty());
+  CHECK(md.medium.g == 0.0);
+  CHECK(md.vdb.interpolation == femto::VdbMediumDesc::Interpolation::Nearest);
+  CHECK(md.vdb.transform.scale.y == 1);
+  CHECK(md.time_uniform_rate == 0.0);  // automatic
+  CHECK(md.mis_heuristic == femto::MisHeuristic::Balance);
+
+  // A constant albedo; a dielectric around a VDB medium of the same eta.
+  Json c = minimal_vdb();
+  c["albedo"] = 0.25;
+  c["eta"] = 1.33;
+  j = vdb_scene(c);
+  j["shapes"][0]["medium"] = "cloud";  // the dielectric sphere of eta 1.33
+  const SceneDesc e = load(j);
+  CHECK(e.media[2].vdb.albedo == 0.25);
+  CHECK(e.shapes[0].interior_medium == 2);
+}
+
+TEST_CASE("scene loader: vdb and distance-sampling errors", "[scene_loader]") {
+  const auto err = [](const std::function<void(Json&)>& edit) {
+    Json c = minimal_vdb();
+    edit(c);
+    return error_of(vdb_scene(c));
+  };
+  CHECK_THAT(err([](Json& c) { c.erase("sigma_t_scale"); }),
+             Contains("/media/cloud/sigma_t_scale: missing required key 'sigma_t_scale'"));
+  CHECK_THAT(err([](Json& c) { c["sigma_t_scale"] = 0; }),
+             Contains("/media/cloud/sigma_t_scale: must be > 0 (got 0)"));
+  CHECK_THAT(err([](Json& c) { c.erase("file"); }),
+             Contains("/media/cloud/file: missing required key 'file'"));
+  CHECK_THAT(err([](Json& c) { c["file"] = "nope.vdb"; }),
+             Contains("/media/cloud/file: VDB file not found: ") && Contains("nope.vdb") &&
+                 Contains("(got \"nope.vdb\")"));
+  CHECK_THAT(err([](Json& c) { c["file"] = ""; }), Contains("/media/cloud/file: must name a VDB file"));
+  CHECK_THAT(err([](Json& c) { c["file"] = 3; }), Contains("/media/cloud/file: expected a string"));
+  CHECK_THAT(err([](Json& c) { c["density_grid"] = ""; }),
+             Contains("/media/cloud/density_grid: must name a grid"));
+  CHECK_THAT(err([](Json& c) { c["eta_grid"] = 1.4; }),
+             Contains("/media/cloud/eta_grid: expected a string (got 1.4)"));
+  CHECK_THAT(err([](Json& c) {
+               c["albedo"] = 0.5;
+               c["albedo_grid"] = "albedo";
+             }),
+             Contains("/media/cloud/albedo_grid: give either 'albedo'") && Contains("not both"));
+  CHECK_THAT(err([](Json& c) { c["albedo"] = 1.5; }),
+             Contains("/media/cloud/albedo: must be in [0, 1] (got 1.5)"));
+  CHECK_THAT(err([](Json& c) { c["eta"] = 0.9; }), Contains("/media/cloud/eta: must be >= 1 (got 0.9)"));
+  CHECK_THAT(err([](Json& c) { c["g"] = 1; }), Contains("/media/cloud/g: must be in (-1, 1) (got 1)"));
+  CHECK_THAT(err([](Json& c) { c["interpolation"] = "cubic"; }),
+             Contains("/media/cloud/interpolation: must be one of \"nearest\", \"trilinear\""));
+  CHECK_THAT(err([](Json& c) { c["transform"] = {{"scale", 0}}; }),
+             Contains("/media/cloud/transform/scale: must be non-zero (got 0)"));
+  CHECK_THAT(err([](Json& c) { c["transform"] = {{"shift", {1, 2, 3}}}; }),
+             Contains("/media/cloud/transform/shift: unknown key 'shift'"));
+  CHECK_THAT(err([](Json& c) { c["sigma_a"] = 0.1; }),
+             Contains("/media/cloud/sigma_a: key 'sigma_a' does not apply to a vdb medium"));
+  CHECK_THAT(err([](Json& c) { c["sigma_t_scal"] = 0.1; }),
+             Contains("unknown key 'sigma_t_scal'") && Contains("did you mean 'sigma_t_scale'"));
+  CHECK_THAT(err([](Json& c) { c["type"] = "voxel"; }),
+             Contains("/media/cloud/type: must be one of \"homogeneous\", \"vdb\""));
+
+  Json j = base_scene();
+  j["media"]["fog"]["file"] = "cloud.vdb";
+  CHECK_THAT(error_of(j),
+             Contains("/media/fog/file: key 'file' does not apply to a homogeneous medium"));
+
+  // Distance sampling, on both medium types.
+  CHECK_THAT(err([](Json& c) { c["distance_sampling"] = "uniform"; }),
+             Contains("/media/cloud/distance_sampling: must be one of \"mfp\", \"time_uniform\", \"mis\""));
+  CHECK_THAT(err([](Json& c) {
+               c["distance_sampling"] = "mfp";
+               c["time_uniform_rate"] = 1;
+             }),
+             Contains("/media/cloud/time_uniform_rate: only applies with") &&
+                 Contains("this medium uses \"mfp\"") && Contains("(got 1)"));
+  CHECK_THAT(err([](Json& c) {
+               c["distance_sampling"] = "time_uniform";
+               c["time_uniform_rate"] = 0;
+             }),
+             Contains("/media/cloud/time_uniform_rate: must be > 0 (got 0)"));
+  CHECK_THAT(err([](Json& c) {
+               c["distance_sampling"] = "time_uniform";
+               c["mis_heuristic"] = "power";
+             }),
+             Contains("/media/cloud/mis_heuristic: only applies with \"distance_sampling\": \"mis\""));
+  CHECK_THAT(err([](Json& c) {
+               c["distance_sampling"] = "mis";
+               c["mis_heuristic"] = "max";
+             }),
+             Contains("/media/cloud/mis_heuristic: must be one of \"balance\", \"power\""));
+  j = base_scene();
+  j["media"]["fog"]["distance_sampling"] = "mfp";
+  j["media"]["fog"]["mis_heuristic"] = "balance";
+  CHECK_THAT(error_of(j), Contains("/media/fog/mis_heuristic: only applies"));
+  j = base_scene();
+  j["media"]["air"]["time_uniform_rate"] = -1;
+  CHECK_THAT(error_of(j), Contains("/media/air/time_uniform_rate: must be > 0 (got -1)"));
+
+  // A dielectric around a VDB medium must match its constant eta.
+  j = vdb_scene(minimal_vdb());
+  j["shapes"][0]["medium"] = "cloud";  // dielectric sphere of eta 1.33, medium eta 1
+  CHECK_THAT(error_of(j), Contains("/shapes/0/material/eta") && Contains("'cloud'"));
 }
 
 TEST_CASE("obj loader: faces, indices and errors", "[obj_loader]") {
