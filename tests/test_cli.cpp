@@ -2,6 +2,8 @@
 // in a fresh temporary folder and check its exit code, its stderr and the files it writes.
 #include <catch2/catch.hpp>
 
+#include "temp_dir.h"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,22 +35,8 @@ using nlohmann::json;
 
 namespace {
 
-// A fresh folder per test case, removed afterwards.
-struct CliTempDir {
-  fs::path dir;
-  CliTempDir() {
-    static int counter = 0;
-    dir = fs::temp_directory_path() /
-          ("femto_test_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~CliTempDir() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-  CliTempDir(const CliTempDir&) = delete;
-  CliTempDir& operator=(const CliTempDir&) = delete;
+struct CliTempDir : femto::test::TempDir {
+  CliTempDir() : femto::test::TempDir("femto_test_cli") {}
 };
 
 std::string read_text(const fs::path& p) {

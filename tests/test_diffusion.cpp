@@ -3,6 +3,8 @@
 // diffusion), determinism across thread counts, the plot module and the command line.
 #include <catch2/catch.hpp>
 
+#include "temp_dir.h"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -384,19 +386,8 @@ Run run_femto(const std::vector<std::string>& args, const fs::path& cwd) {
   return r;
 }
 
-struct TempDir {
-  fs::path dir;
-  TempDir() {
-    static int counter = 0;
-    dir = fs::temp_directory_path() /
-          ("femto_test_diffusion_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
+struct TempDir : test::TempDir {
+  TempDir() : test::TempDir("femto_test_diffusion") {}
 };
 
 }  // namespace

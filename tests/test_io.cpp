@@ -18,26 +18,16 @@
 #include "core/io/npy.h"
 #include "core/io/png.h"
 #include "core/io/tonemap.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace femto;
 
 namespace {
 
-// A fresh directory per test case, removed afterwards.
-struct TempDir {
-  fs::path dir;
-  TempDir() {
-    static int counter = 0;
-    dir = fs::temp_directory_path() /
-          ("femto_test_io_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
+// A fresh directory per test case, removed afterwards, with path and leftover helpers.
+struct TempDir : test::TempDir {
+  TempDir() : test::TempDir("femto_test_io") {}
   std::string operator/(const std::string& name) const { return (dir / name).string(); }
   // Names of the leftover temporaries (".tmp.") in the directory.
   std::vector<std::string> temporaries() const {
