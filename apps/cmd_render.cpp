@@ -1,4 +1,5 @@
 // `femto render`: loads a scene (or the built-in one), renders it and writes the outputs.
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -33,6 +34,16 @@ const char* kRenderHelp =
     "  --distance-sampling S  collision-distance sampling in every medium, overriding the\n"
     "                     scene: mfp (mean free path), time_uniform (exponential in optical\n"
     "                     path length, uniform vertex times) or mis (both, combined by MIS)\n"
+    "  --reconstruction R how path contributions become time bins: histogram (one bin per\n"
+    "                     contribution) or kernel (progressive kernel density estimation:\n"
+    "                     smooth, consistent frames; docs/outputs.md)\n"
+    "  --kernel K         kernel film: perlin (default) or epanechnikov\n"
+    "  --alpha A          kernel film: bandwidth shrinking, T_{j+1} = T_j (j + A) / (j + 1),\n"
+    "                     0 < A <= 1 (default 0.8; 1 keeps the bandwidth fixed: biased)\n"
+    "  --knn K            kernel film: k of the k-nearest-arrival initial bandwidth (default 40)\n"
+    "  --first-pass-spp N kernel film: samples whose arrival times set the bandwidth (default\n"
+    "                     160; all samples when spp is lower)\n"
+    "  --bandwidth PS     kernel film: initial bandwidth T_1 in ps instead of the k-NN choice\n"
     "  --max-depth N      safety bound on scattering/bounce vertices per path; paths stopped by\n"
     "                     it are counted in render.json (scene default: 1000)\n"
     "  --out DIR          output folder, created if missing (default ./femto-out)\n"
@@ -58,6 +69,27 @@ std::string read_text(const std::string& path) {
   return ss.str();
 }
 
+nlohmann::json reconstruction_json(const ReconstructionDesc& r, const RenderResult& result) {
+  if (r.type == TemporalFilter::Kind::Histogram) return {{"type", "histogram"}};
+  nlohmann::json j = {{"type", "kernel"},
+                      {"kernel", r.kernel == TemporalKernel::Perlin ? "perlin" : "epanechnikov"},
+                      {"alpha", r.alpha},
+                      {"schedule", "T_{j+1} = T_j (j + alpha) / (j + 1), j = sample index from 1"}};
+  if (r.bandwidth_ps > 0) {
+    j["initial_bandwidth_ps"] = r.bandwidth_ps;
+  } else {
+    j["initial_bandwidth"] = "k nearest arrivals of the first pass, per pixel";
+    j["k"] = r.knn;
+    j["first_pass_spp"] = r.first_pass_spp;
+  }
+  std::vector<float> T = result.final_bandwidth_ps;
+  if (!T.empty()) {
+    std::sort(T.begin(), T.end());
+    j["final_bandwidth_ps"] = {{"min", T.front()}, {"median", T[T.size() / 2]}, {"max", T.back()}};
+  }
+  return j;
+}
+
 }  // namespace
 
 namespace {
@@ -67,6 +99,11 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   std::optional<int> spp, max_depth;
   std::optional<uint64_t> seed;
   std::optional<DistanceSampling> sampling;
+  std::optional<TemporalFilter::Kind> reconstruction;
+  std::optional<TemporalKernel> kernel;
+  std::optional<double> alpha, bandwidth;
+  std::optional<int> knn, first_pass_spp;
+  std::string kernel_flag;  // the first kernel-only flag given, for the error message
   int threads = 0;
   OutputOptions out;
   bool quiet = false;
@@ -88,6 +125,31 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       else if (v == "time_uniform") sampling = DistanceSampling::TimeUniform;
       else if (v == "mis") sampling = DistanceSampling::Mis;
       else args.fail("expected mfp, time_uniform or mis", v);
+    } else if (a == "--reconstruction") {
+      const std::string v = args.value();
+      if (v == "histogram") reconstruction = TemporalFilter::Kind::Histogram;
+      else if (v == "kernel") reconstruction = TemporalFilter::Kind::Kernel;
+      else args.fail("expected histogram or kernel", v);
+    } else if (a == "--kernel") {
+      const std::string v = args.value();
+      if (v == "perlin") kernel = TemporalKernel::Perlin;
+      else if (v == "epanechnikov") kernel = TemporalKernel::Epanechnikov;
+      else args.fail("expected perlin or epanechnikov", v);
+      if (kernel_flag.empty()) kernel_flag = a;
+    } else if (a == "--alpha") {
+      alpha = args.double_value(0.0, 1.0);
+      if (!(*alpha > 0.0)) args.fail("must be in (0, 1]", std::to_string(*alpha));
+      if (kernel_flag.empty()) kernel_flag = a;
+    } else if (a == "--knn") {
+      knn = static_cast<int>(args.int_value(1, 100000));
+      if (kernel_flag.empty()) kernel_flag = a;
+    } else if (a == "--first-pass-spp") {
+      first_pass_spp = static_cast<int>(args.int_value(1, 1000000));
+      if (kernel_flag.empty()) kernel_flag = a;
+    } else if (a == "--bandwidth") {
+      bandwidth = args.double_value(0.0, 1e12);
+      if (!(*bandwidth > 0.0)) args.fail("must be > 0 ps", std::to_string(*bandwidth));
+      if (kernel_flag.empty()) kernel_flag = a;
     } else if (a == "--max-depth") {
       max_depth = static_cast<int>(args.int_value(1, 1000000));
     } else if (a == "--out") {
@@ -126,6 +188,17 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   }
   if (sampling)
     for (MediumDesc& m : desc.media) m.sampling = *sampling;
+  ReconstructionDesc& rec = desc.reconstruction;
+  if (reconstruction) rec.type = *reconstruction;
+  if (!kernel_flag.empty() && rec.type != TemporalFilter::Kind::Kernel)
+    throw InputError("femto render: " + kernel_flag +
+                     ": applies to the kernel film only; add --reconstruction kernel (or set "
+                     "/time/reconstruction in the scene)");
+  if (kernel) rec.kernel = *kernel;
+  if (alpha) rec.alpha = *alpha;
+  if (knn) rec.knn = *knn;
+  if (first_pass_spp) rec.first_pass_spp = *first_pass_spp;
+  if (bandwidth) rec.bandwidth_ps = *bandwidth;
   RenderOptions opt;
   opt.spp = spp.value_or(desc.integrator.spp);
   opt.seed = seed.value_or(desc.integrator.seed);
@@ -161,7 +234,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"threads", result.threads},
                       {"max_depth", opt.max_depth},
                       {"integrator", "volpath (mean-free-path sampling, NEE + MIS)"},
-                      {"reconstruction", "histogram"},
+                      {"reconstruction", reconstruction_json(scene.desc().reconstruction, result)},
                       {"russian_roulette", false}};
   nlohmann::json media = nlohmann::json::array();
   {
@@ -208,7 +281,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                     {"after_window", rgb_json(result.film.total_after())},
                     {"note", "sums over pixels; after_window only counts contributions of paths "
                              "still alive (paths stop once they pass the window end)"}};
-  write_outputs(result.film, out, info);
+  write_outputs(result.film, out, info, result.final_bandwidth_ps);
   if (!quiet) {
     std::fprintf(stderr, "femto: %llu paths in %s (%.3g paths/s, %d threads)\n",
                  static_cast<unsigned long long>(st.paths), format_duration(result.wall_seconds).c_str(),

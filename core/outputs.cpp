@@ -23,7 +23,8 @@ std::string frame_file_name(const TimeAxis& axis, int t) {
   return buf;
 }
 
-void write_outputs(const TransientFilm& film, const OutputOptions& opt, nlohmann::json info) {
+void write_outputs(const TransientFilm& film, const OutputOptions& opt, nlohmann::json info,
+                   const std::vector<float>& bandwidth_ps) {
   const fs::path dir(opt.dir);
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -48,6 +49,11 @@ void write_outputs(const TransientFilm& film, const OutputOptions& opt, nlohmann
   write_exr_channels(path_of("peak_time.exr"), W, H, {"Y"}, {peak.data()},
                      {{"femto:units", "ps (centre of the brightest bin; NaN where empty)"}});
   files.push_back("peak_time.exr");
+  if (!bandwidth_ps.empty()) {
+    write_exr_channels(path_of("kernel_bandwidth.exr"), W, H, {"Y"}, {bandwidth_ps.data()},
+                       {{"femto:units", "ps (temporal kernel bandwidth of each pixel's last sample)"}});
+    files.push_back("kernel_bandwidth.exr");
+  }
 
   if (opt.frames == OutputOptions::Frames::Files) {
     fs::create_directories(dir / "frames", ec);

@@ -1,6 +1,7 @@
 #pragma once
 // Renders a scene into a transient film with oneTBB over image tiles.
 #include <cstdint>
+#include <vector>
 
 #include "core/film.h"
 #include "core/integrators/volpath.h"
@@ -21,9 +22,11 @@ struct RenderResult {
   PathStats stats;
   double wall_seconds = 0;
   int threads = 0;
+  /// Kernel film: bandwidth (ps) of each pixel's last sample, (H, W); empty for the histogram.
+  std::vector<float> final_bandwidth_ps;
 };
 
-/// Traces spp paths per pixel. The result is bit-identical for a given seed whatever the thread
+/// Traces spp paths per pixel and reconstructs time with the scene's `reconstruction`. The result is bit-identical for a given seed whatever the thread
 /// count: every sample has its own random stream and each pixel sums its samples in order.
 RenderResult render(const Scene& scene, const RenderOptions& options);
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/reconstruction.h"
 #include "core/spectrum.h"
 #include "core/time_axis.h"
 #include "core/vec3.h"
@@ -123,6 +124,7 @@ struct SceneDesc {
   CameraDesc camera;
   TimeAxis time;
   TimeMode time_mode = TimeMode::Camera;
+  ReconstructionDesc reconstruction;  ///< /time/reconstruction
   std::vector<MediumDesc> media;
   int global_medium = -1;        ///< medium filling everything outside closed shapes; -1 = vacuum
   std::vector<ShapeDesc> shapes;

@@ -515,7 +515,8 @@ class Loader {
   void time(const Json& v, SceneDesc& scene) const {
     const std::string p = "/time";
     const Json& o = object(v, p);
-    check_keys(o, p, {"t_start", "bin_width", "bins", "start_opl", "bin_width_opl", "mode"});
+    check_keys(o, p,
+               {"t_start", "bin_width", "bins", "start_opl", "bin_width_opl", "mode", "reconstruction"});
     const Json* bw = find(o, "bin_width");
     const Json* bw_opl = find(o, "bin_width_opl");
     if (bw && bw_opl)
@@ -561,6 +562,33 @@ class Loader {
       scene.time_mode = choice(*m, at(p, "mode"), {"camera", "unwarp"}) == "camera"
                             ? TimeMode::Camera
                             : TimeMode::Unwarp;
+    if (const Json* r = find(o, "reconstruction")) reconstruction(*r, at(p, "reconstruction"), scene.reconstruction);
+  }
+
+  // "histogram", or {"type": "kernel", "kernel", "alpha", "k", "first_pass_spp", "bandwidth"}.
+  void reconstruction(const Json& v, const std::string& p, ReconstructionDesc& r) const {
+    const Keys kernel_keys = {"kernel", "alpha", "k", "first_pass_spp", "bandwidth"};
+    if (v.is_string()) {
+      r.type = choice(v, p, {"histogram", "kernel"}) == "kernel" ? TemporalFilter::Kind::Kernel
+                                                                 : TemporalFilter::Kind::Histogram;
+      return;
+    }
+    const Json& o = object(v, p);
+    const std::string type = type_of(o, p, {"histogram", "kernel"}, kernel_keys);
+    if (type == "histogram") {
+      check_keys(o, p, {"type"}, "the histogram reconstruction", kernel_keys);
+      r.type = TemporalFilter::Kind::Histogram;
+      return;
+    }
+    check_keys(o, p, join(Keys{"type"}, kernel_keys));
+    r.type = TemporalFilter::Kind::Kernel;
+    if (const Json* k = find(o, "kernel"))
+      r.kernel = choice(*k, at(p, "kernel"), {"perlin", "epanechnikov"}) == "perlin" ? TemporalKernel::Perlin
+                                                                                   : TemporalKernel::Epanechnikov;
+    if (const Json* a = find(o, "alpha")) r.alpha = number(*a, at(p, "alpha"), within(0, 1, true, false));
+    if (const Json* k = find(o, "k")) r.knn = int_in(*k, at(p, "k"), 1, 100000);
+    if (const Json* f = find(o, "first_pass_spp")) r.first_pass_spp = int_in(*f, at(p, "first_pass_spp"), 1, 1000000);
+    if (const Json* b = find(o, "bandwidth")) r.bandwidth_ps = number(*b, at(p, "bandwidth"), above(0));
   }
 
   void media(const Json& v, SceneDesc& scene) const {

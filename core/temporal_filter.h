@@ -1,10 +1,14 @@
 #pragma once
 // Temporal reconstruction: how one time-stamped contribution is spread over the film's time bins.
-// The histogram puts it in one bin; a light's Gaussian pulse is integrated exactly over the bins
-// it overlaps. A progressive kernel estimator will be a second kind behind this same interface.
+// The histogram puts it in one bin; the kernel film spreads it with a compact kernel K_T of
+// bandwidth T (core/temporal_kernel.h). Either way the deposit is integrated exactly over every
+// bin it overlaps, so its energy is kept bin by bin, and a light's Gaussian pulse is integrated
+// exactly as well.
+#include <algorithm>
 #include <cmath>
 
 #include "core/spectrum.h"
+#include "core/temporal_kernel.h"
 #include "core/time_axis.h"
 
 namespace femto {
@@ -18,17 +22,34 @@ struct DepositSplit {
 
 class TemporalFilter {
  public:
-  enum class Kind { Histogram };
+  enum class Kind { Histogram, Kernel };
 
   TemporalFilter() = default;
-  TemporalFilter(const TimeAxis& axis, Kind kind) : axis_(axis), kind_(kind) {}
+  TemporalFilter(const TimeAxis& axis, Kind kind, TemporalKernel kernel = TemporalKernel::Perlin)
+      : axis_(axis), kind_(kind), kernel_(kernel) {}
 
   const TimeAxis& axis() const { return axis_; }
   Kind kind() const { return kind_; }
+  TemporalKernel kernel() const { return kernel_; }
 
   /// Adds `value` arriving at t_ps, smeared by a Gaussian of std sigma_ps (0 = delta), into the
   /// pixel's bin buffer `bins` (bins x 3 doubles). Returns the fractions outside the window.
-  DepositSplit deposit(double t_ps, double sigma_ps, const RGB& value, double* bins) const {
+  /// A kernel filter with bandwidth T > 0 spreads a delta arrival by K_T; a Gaussian arrival gets
+  /// the Gaussian whose variance is the pulse's plus the kernel's (exact in energy and variance,
+  /// not in shape; the bias still vanishes as T -> 0). T <= 0 deposits like the histogram.
+  DepositSplit deposit(double t_ps, double sigma_ps, const RGB& value, double* bins,
+                       double bandwidth_ps = 0.0) const {
+    if (kind_ == Kind::Kernel && bandwidth_ps > 0.0) {
+      if (sigma_ps <= 0.0) return deposit_kernel(t_ps, bandwidth_ps, value, bins);
+      sigma_ps = std::sqrt(sigma_ps * sigma_ps + kernel_variance(kernel_) * bandwidth_ps * bandwidth_ps);
+    }
+    return deposit_histogram(t_ps, sigma_ps, value, bins);
+  }
+
+  static double gaussian_cdf(double z) { return 0.5 * std::erfc(-z * 0.70710678118654752440); }
+
+ private:
+  DepositSplit deposit_histogram(double t_ps, double sigma_ps, const RGB& value, double* bins) const {
     DepositSplit split;
     if (sigma_ps <= 0.0) {
       const int i = axis_.bin_of(t_ps);
@@ -62,9 +83,27 @@ class TemporalFilter {
     return split;
   }
 
-  static double gaussian_cdf(double z) { return 0.5 * std::erfc(-z * 0.70710678118654752440); }
+  /// K_T(. - t) integrated over each bin of [t - T, t + T] by kernel CDF differences.
+  DepositSplit deposit_kernel(double t_ps, double T, const RGB& value, double* bins) const {
+    const double t0 = axis_.t_start_ps, w = axis_.bin_width_ps, t_end = axis_.t_end_ps();
+    DepositSplit split;
+    split.before = kernel_cdf(kernel_, (t0 - t_ps) / T);
+    split.after = 1.0 - kernel_cdf(kernel_, (t_end - t_ps) / T);
+    const double lo = std::fmax(t0, t_ps - T), hi = std::fmin(t_end, t_ps + T);
+    if (lo >= hi) return split;
+    int i = static_cast<int>((lo - t0) / w);
+    const int i_end = std::min(axis_.bins - 1, static_cast<int>((hi - t0) / w));
+    double cdf_prev = kernel_cdf(kernel_, (t0 + i * w - t_ps) / T);
+    for (; i <= i_end; ++i) {
+      const double cdf_next = kernel_cdf(kernel_, (t0 + (i + 1) * w - t_ps) / T);
+      const double f = cdf_next - cdf_prev;
+      cdf_prev = cdf_next;
+      if (f > 0.0) add(bins, i, value, f);
+      split.inside += f;
+    }
+    return split;
+  }
 
- private:
   static void add(double* bins, int i, const RGB& v, double f) {
     double* b = bins + 3 * i;
     b[0] += v.r * f;
@@ -74,6 +113,7 @@ class TemporalFilter {
 
   TimeAxis axis_;
   Kind kind_ = Kind::Histogram;
+  TemporalKernel kernel_ = TemporalKernel::Perlin;
 };
 
 }  // namespace femto

@@ -37,6 +37,11 @@ inline double kernel_bin_weight(TemporalKernel k, double t, double T, double b0,
   return kernel_cdf(k, (b1 - t) / T) - kernel_cdf(k, (b0 - t) / T);
 }
 
+/// Variance of k on [-1, 1]: the kernel K_T has variance kernel_variance(k) * T^2.
+inline double kernel_variance(TemporalKernel k) {
+  return k == TemporalKernel::Epanechnikov ? 1.0 / 5.0 : 5.0 / 42.0;
+}
+
 /// Progressive bandwidth schedule of seed 000 Sec. 4 / Supp. B: T_{j+1} = T_j (j + alpha) / (j + 1)
 /// after pass j (j = 1, 2, ...), alpha in (0, 1); alpha = 4/5 gives AMSE O(n^-4/5).
 inline double next_bandwidth(double T_j, int j, double alpha) {

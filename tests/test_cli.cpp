@@ -276,6 +276,72 @@ TEST_CASE("cli: --frames multipart and --frames none", "[cli]") {
   }
 }
 
+// Catches: the kernel film's scene keys or flags being ignored, render.json not recording them,
+// kernel_bandwidth.exr missing or holding nonsense, and the kernel film losing energy against the
+// histogram film rendered from the same paths.
+TEST_CASE("cli: --reconstruction kernel records its settings and keeps the histogram's energy", "[cli]") {
+  CliTempDir tmp;
+  json scene = small_scene();
+  scene["time"]["reconstruction"] = {{"type", "kernel"}, {"kernel", "perlin"}, {"k", 12}};
+  write_text(tmp.dir / "scene.json", scene.dump(2));
+  const fs::path kout = tmp.dir / "kernel", hout = tmp.dir / "histogram";
+  const RunResult k = run_femto({"render", "scene.json", "--spp", "6", "--kernel", "epanechnikov", "--alpha",
+                                 "0.7", "--frames", "none", "--no-previews", "--out", kout.string(), "--quiet"},
+                                tmp.dir, tmp.dir / "logs_k");
+  INFO(k.command << "\nstderr: " << k.err);
+  REQUIRE(k.code == 0);
+  const RunResult h = run_femto({"render", "scene.json", "--spp", "6", "--reconstruction", "histogram", "--frames",
+                                 "none", "--no-previews", "--out", hout.string(), "--quiet"},
+                                tmp.dir, tmp.dir / "logs_h");
+  INFO(h.command << "\nstderr: " << h.err);
+  REQUIRE(h.code == 0);
+
+  const json kj = json::parse(read_text(kout / "render.json"));
+  const json& rec = kj["settings"]["reconstruction"];
+  CHECK(rec["type"] == "kernel");
+  CHECK(rec["kernel"] == "epanechnikov");  // the flag overrides the scene
+  CHECK(rec["alpha"].get<double>() == 0.7);
+  CHECK(rec["k"].get<int>() == 12);        // the scene's key survives
+  CHECK(rec["first_pass_spp"].get<int>() == 160);
+  CHECK(json::parse(read_text(hout / "render.json"))["settings"]["reconstruction"]["type"] == "histogram");
+  CHECK_FALSE(fs::exists(hout / "kernel_bandwidth.exr"));
+
+  int w = 0, hgt = 0;
+  std::vector<float> T;
+  femto::read_exr_channel((kout / "kernel_bandwidth.exr").string(), 0, "Y", w, hgt, T);
+  REQUIRE(T.size() == 40u * 24u);
+  const double window = 50.0 * 24;
+  for (float t : T) CHECK((t >= 0.0f && t <= window));
+
+  // Same seed, same paths: bins + before + after agree pixel by pixel (float storage).
+  auto totals = [](const fs::path& dir) {
+    std::vector<size_t> shape;
+    std::vector<float> film;
+    femto::read_npy_float32((dir / "transient.npy").string(), shape, film);
+    int ww = 0, hh = 0;
+    std::vector<float> before, after;
+    femto::read_exr_rgb((dir / "before_window.exr").string(), ww, hh, before);
+    femto::read_exr_rgb((dir / "after_window.exr").string(), ww, hh, after);
+    std::vector<double> sum(before.size(), 0.0);
+    const size_t bins = shape[2];
+    for (size_t p = 0; p < sum.size() / 3; ++p)
+      for (size_t c = 0; c < 3; ++c) {
+        double s = double(before[3 * p + c]) + double(after[3 * p + c]);
+        for (size_t i = 0; i < bins; ++i) s += film[(p * bins + i) * 3 + c];
+        sum[3 * p + c] = s;
+      }
+    return sum;
+  };
+  const std::vector<double> ks = totals(kout), hs = totals(hout);
+  REQUIRE(ks.size() == hs.size());
+  double total = 0;
+  for (size_t i = 0; i < ks.size(); ++i) {
+    CHECK(std::abs(ks[i] - hs[i]) <= 1e-5 * std::max(1e-30, hs[i]));
+    total += hs[i];
+  }
+  CHECK(total > 0);
+}
+
 // Catches: --version/--help failing or printing the wrong version, and the render help going out
 // of sync with the options cmd_render.cpp actually parses.
 TEST_CASE("cli: --version and --help", "[cli]") {
@@ -356,6 +422,16 @@ TEST_CASE("cli: bad input exits 2 with a one-line message and writes nothing", "
        {"render", "no_such_scene.json", "--out", out}, {"no_such_scene.json"}},
       {"two scene files: the second silently ignored",
        {"render", good, "other.json", "--out", out}, {"other.json"}},
+      {"unknown --reconstruction falling back to the histogram",
+       {"render", good, "--reconstruction", "kde", "--out", out}, {"--reconstruction", "kde"}},
+      {"kernel settings silently ignored by a histogram render",
+       {"render", good, "--alpha", "0.5", "--out", out}, {"--alpha", "--reconstruction kernel"}},
+      {"alpha = 0 accepted (the bandwidth would collapse after one sample)",
+       {"render", good, "--reconstruction", "kernel", "--alpha", "0", "--out", out}, {"--alpha", "0"}},
+      {"a zero bandwidth accepted",
+       {"render", good, "--reconstruction", "kernel", "--bandwidth", "0", "--out", out}, {"--bandwidth"}},
+      {"unknown kernel names accepted",
+       {"render", good, "--reconstruction", "kernel", "--kernel", "gauss", "--out", out}, {"--kernel", "gauss"}},
   };
 
   // Scene-file errors: each scene is the valid small scene with one defect.
@@ -390,6 +466,13 @@ TEST_CASE("cli: bad input exits 2 with a one-line message and writes nothing", "
   bad_scene("zero bins accepted (empty film)",
             scene_with("bins.json", [](json& s) { s["time"]["bins"] = 0; }),
             {"/time/bins", "0"});
+  bad_scene("a kernel alpha above 1 accepted (a growing bandwidth: inconsistent)",
+            scene_with("alpha.json",
+                       [](json& s) { s["time"]["reconstruction"] = {{"type", "kernel"}, {"alpha", 1.5}}; }),
+            {"/time/reconstruction/alpha", "1.5"});
+  bad_scene("a misspelt reconstruction accepted",
+            scene_with("recon.json", [](json& s) { s["time"]["reconstruction"] = "kernal"; }),
+            {"/time/reconstruction", "kernal"});
   bad_scene("a missing mesh file reported late or vaguely",
             scene_with("mesh.json",
                        [](json& s) {

@@ -415,6 +415,42 @@ TEST_CASE("scene loader: out-of-range numbers", "[scene_loader]") {
              Contains("line 2") && Contains("1e999"));
 }
 
+// Catches: reconstruction keys read into the wrong field, defaults that differ from the
+// documented ones, and out-of-range kernel settings accepted.
+TEST_CASE("scene loader: temporal reconstruction", "[scene_loader]") {
+  Json j = base_scene();
+  CHECK(load(j).reconstruction.type == femto::TemporalFilter::Kind::Histogram);
+  j["time"]["reconstruction"] = "kernel";
+  femto::ReconstructionDesc r = load(j).reconstruction;
+  CHECK(r.type == femto::TemporalFilter::Kind::Kernel);
+  CHECK(r.kernel == femto::TemporalKernel::Perlin);
+  CHECK(r.alpha == 0.8);
+  CHECK(r.knn == 40);
+  CHECK(r.first_pass_spp == 160);
+  CHECK(r.bandwidth_ps == 0.0);
+  j["time"]["reconstruction"] = {{"type", "kernel"}, {"kernel", "epanechnikov"}, {"alpha", 1},
+                                 {"k", 7}, {"first_pass_spp", 9}, {"bandwidth", 12.5}};
+  r = load(j).reconstruction;
+  CHECK(r.kernel == femto::TemporalKernel::Epanechnikov);
+  CHECK(r.alpha == 1.0);
+  CHECK(r.knn == 7);
+  CHECK(r.first_pass_spp == 9);
+  CHECK(r.bandwidth_ps == 12.5);
+
+  j["time"]["reconstruction"] = {{"type", "kernel"}, {"alpha", 0}};
+  CHECK_THAT(error_of(j), Contains("/time/reconstruction/alpha: must be in (0, 1] (got 0)"));
+  j["time"]["reconstruction"] = {{"type", "kernel"}, {"k", 0}};
+  CHECK_THAT(error_of(j), Contains("/time/reconstruction/k: must be in [1, 100000] (got 0)"));
+  j["time"]["reconstruction"] = {{"type", "kernel"}, {"bandwidth", -1}};
+  CHECK_THAT(error_of(j), Contains("/time/reconstruction/bandwidth: must be > 0 (got -1)"));
+  j["time"]["reconstruction"] = {{"type", "histogram"}, {"alpha", 0.5}};
+  CHECK_THAT(error_of(j), Contains("/time/reconstruction/alpha: key 'alpha' does not apply to the histogram"));
+  j["time"]["reconstruction"] = {{"type", "kernel"}, {"kernal", "perlin"}};
+  CHECK_THAT(error_of(j), Contains("/time/reconstruction/kernal: unknown key") && Contains("kernel"));
+  j["time"]["reconstruction"] = 3;
+  CHECK_THAT(error_of(j), Contains("/time/reconstruction: expected an object"));
+}
+
 TEST_CASE("scene loader: huge film", "[scene_loader]") {
   Json j = base_scene();
   j["camera"]["resolution"] = {16384, 16384};

@@ -8,6 +8,7 @@
 #include "media/phase_hg.h"
 #include "samplers/stats.h"
 #include "scene_builders.h"
+#include "single_scatter.h"
 
 using namespace femto;
 using namespace femto::test;
@@ -191,33 +192,6 @@ TEST_CASE("furnace: emissive diffuse box gives Le / (1 - rho) time-integrated", 
   SECTION("medium inside an index-matched sphere") { check_furnace(0.08, 0.3, true); }
 }
 
-namespace {
-struct SingleScatterSetup {
-  double sigma_a = 0.01, sigma_s = 0.05, g = 0.4, eta = 1.2, h = 30.0, I = 1000.0;
-  TimeAxis axis;
-};
-
-// Expected bin-integrated single-scattered radiance along the ray x(s) = (0, 0, s) with the
-// point light at (0, h, 0), in camera time t(s) = eta (s + r(s)) / c.
-double single_scatter_bin(const SingleScatterSetup& p, int bin) {
-  const double st = p.sigma_a + p.sigma_s;
-  auto integrand = [&](double s) {
-    const double r = std::sqrt(s * s + p.h * p.h);
-    // Cosine between the propagation directions: light travels (x - L) / r, then -z.
-    const double cos_t = -s / r;
-    return p.sigma_s * std::exp(-st * s) * hg_eval(cos_t, p.g) * p.I * std::exp(-st * r) / (r * r);
-  };
-  // s + sqrt(s^2 + h^2) = tau  <=>  s = (tau^2 - h^2) / (2 tau): bin edges in s.
-  auto s_of_t = [&](double t) {
-    const double tau = std::max(t * kSpeedOfLight / p.eta, p.h);
-    return (tau * tau - p.h * p.h) / (2.0 * tau);
-  };
-  const double s0 = s_of_t(p.axis.bin_start_ps(bin)), s1 = s_of_t(p.axis.bin_start_ps(bin + 1));
-  if (s1 <= s0) return 0.0;
-  return stats::adaptive_simpson(integrand, s0, s1, 1e-12);
-}
-}  // namespace
-
 // Catches: wrong phase-function argument or convention, wrong transmittance on either segment,
 // wrong time of the scattering vertex or of the connection, off-by-one bin placement.
 TEST_CASE("single scattering from a point light matches 1-D quadrature bin by bin", "[tracer][analytic]") {
@@ -225,16 +199,7 @@ TEST_CASE("single scattering from a point light matches 1-D quadrature bin by bi
   p.axis.t_start_ps = 100;
   p.axis.bin_width_ps = 10;
   p.axis.bins = 40;
-  SceneDesc d;
-  d.source = "single scattering";
-  d.camera = ortho_camera({0, 0, 0}, {0, 0, 1}, 1e-4, 1, 1);
-  d.time = p.axis;
-  d.media.push_back(medium("m", p.sigma_a, p.sigma_s, p.g, p.eta));
-  d.global_medium = 0;
-  LightDesc l;
-  l.position = {0, p.h, 0};
-  l.intensity = RGB(p.I);
-  d.lights.push_back(l);
+  const SceneDesc d = p.scene();
   const int batches = 32;
   const auto films = render_batches(d, 20000, batches, /*max_depth=*/1);
   int checked = 0;
@@ -242,7 +207,7 @@ TEST_CASE("single scattering from a point light matches 1-D quadrature bin by bi
     std::vector<double> v;
     for (const auto& f : films) v.push_back(f.transient()[3 * i]);
     const MeanSE m = mean_se(v);
-    const double expected = single_scatter_bin(p, i);
+    const double expected = p.bin(i);
     INFO("bin " << i << ": " << m.mean << " +- " << m.se << " expected " << expected);
     if (expected == 0.0) {
       CHECK(m.mean == 0.0);

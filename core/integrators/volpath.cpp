@@ -56,9 +56,7 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
     return;
   }
   if (value.is_black()) return;
-  const DepositSplit split = filter_.deposit(t_ps, sigma_ps, value, acc.bins.data());
-  if (split.before > 0) acc.before += value * split.before;
-  if (split.after > 0) acc.after += value * split.after;
+  acc.add(filter_, t_ps, sigma_ps, value);
 }
 
 VolPathIntegrator::MediumSample VolPathIntegrator::sample_medium(const Medium& med, const Ray& ray, double s_max,

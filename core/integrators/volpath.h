@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/pixel_accumulator.h"
 #include "core/rng.h"
 #include "core/scene.h"
 #include "core/temporal_filter.h"
@@ -23,16 +24,6 @@ struct PathStats {
   uint64_t max_depth_hits = 0;     ///< paths stopped by the max-depth safety bound
   uint64_t nonfinite_dropped = 0;  ///< contributions dropped for being NaN or infinite
   PathStats& operator+=(const PathStats& o);
-};
-
-/// One pixel's running sums over its samples.
-struct PixelAccumulator {
-  std::vector<double> bins;  ///< T x 3
-  RGB before, after;         ///< energy that arrived before / after the window
-  void reset(int n_bins) {
-    bins.assign(static_cast<size_t>(n_bins) * 3, 0.0);
-    before = after = RGB(0.0);
-  }
 };
 
 class VolPathIntegrator {
