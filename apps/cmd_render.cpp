@@ -34,6 +34,12 @@ const char* kRenderHelp =
     "  --distance-sampling S  collision-distance sampling in every medium, overriding the\n"
     "                     scene: mfp (mean free path), time_uniform (exponential in optical\n"
     "                     path length, uniform vertex times) or mis (both, combined by MIS)\n"
+    "  --connection-sampling C  direct light from point and spot lights along each ray\n"
+    "                     segment in every medium: collision (next-event estimation at the\n"
+    "                     collisions), equiangular, line_to_point (uniform in connection time)\n"
+    "                     or mis (line_to_point + equiangular)\n"
+    "  --direction-sampling D   next direction at medium collisions: phase, or angular\n"
+    "                     (half phase, half angular sampling uniform in connection time)\n"
     "  --reconstruction R how path contributions become time bins: histogram (one bin per\n"
     "                     contribution) or kernel (progressive kernel density estimation:\n"
     "                     smooth, consistent frames; docs/outputs.md)\n"
@@ -100,6 +106,8 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   std::optional<uint64_t> seed;
   std::optional<DistanceSampling> sampling;
   std::optional<TemporalFilter::Kind> reconstruction;
+  std::optional<ConnectionSampling> connection;
+  std::optional<DirectionSampling> direction;
   std::optional<TemporalKernel> kernel;
   std::optional<double> alpha, bandwidth;
   std::optional<int> knn, first_pass_spp;
@@ -125,6 +133,18 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       else if (v == "time_uniform") sampling = DistanceSampling::TimeUniform;
       else if (v == "mis") sampling = DistanceSampling::Mis;
       else args.fail("expected mfp, time_uniform or mis", v);
+    } else if (a == "--connection-sampling") {
+      const std::string v = args.value();
+      if (v == "collision") connection = ConnectionSampling::Collision;
+      else if (v == "equiangular") connection = ConnectionSampling::Equiangular;
+      else if (v == "line_to_point") connection = ConnectionSampling::LineToPoint;
+      else if (v == "mis") connection = ConnectionSampling::Mis;
+      else args.fail("expected collision, equiangular, line_to_point or mis", v);
+    } else if (a == "--direction-sampling") {
+      const std::string v = args.value();
+      if (v == "phase") direction = DirectionSampling::Phase;
+      else if (v == "angular") direction = DirectionSampling::Angular;
+      else args.fail("expected phase or angular", v);
     } else if (a == "--reconstruction") {
       const std::string v = args.value();
       if (v == "histogram") reconstruction = TemporalFilter::Kind::Histogram;
@@ -186,8 +206,11 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     scene_text = read_text(scene_path);
     desc = load_scene_file(scene_path);
   }
-  if (sampling)
-    for (MediumDesc& m : desc.media) m.sampling = *sampling;
+  for (MediumDesc& m : desc.media) {
+    if (sampling) m.sampling = *sampling;
+    if (connection) m.connection = *connection;
+    if (direction) m.direction = *direction;
+  }
   ReconstructionDesc& rec = desc.reconstruction;
   if (reconstruction) rec.type = *reconstruction;
   if (!kernel_flag.empty() && rec.type != TemporalFilter::Kind::Kernel)
@@ -248,6 +271,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       if (md.sampling != DistanceSampling::Mfp) e["time_uniform_rate_per_mm_opl"] = rm.strategy.lambda;
       if (md.sampling == DistanceSampling::Mis)
         e["mis_heuristic"] = md.mis_heuristic == MisHeuristic::Power ? "power" : "balance";
+      const char* connections[] = {"collision", "equiangular", "line_to_point", "mis"};
+      e["connection_sampling"] = connections[static_cast<int>(md.connection)];
+      e["direction_sampling"] = md.direction == DirectionSampling::Angular ? "angular" : "phase";
       media.push_back(e);
     }
   }

@@ -30,6 +30,9 @@ struct Light {
   PulseDesc pulse;
 };
 
+/// Point and spot lights: a single emitting point, the target of segment connections.
+inline bool is_point_like(const Light& l) { return l.type == Light::Type::Point || l.type == Light::Type::Spot; }
+
 class LightSet {
  public:
   LightSet(const SceneDesc& scene);

@@ -18,6 +18,8 @@ Scene::Scene(SceneDesc desc)
     m.strategy.kind = md.sampling;
     m.strategy.lambda = md.time_uniform_rate > 0 ? md.time_uniform_rate : lambda_auto;
     m.strategy.heuristic = md.mis_heuristic;
+    m.connection = md.connection;
+    m.direction = md.direction;
     if (md.type == MediumDesc::Type::Vdb) {
       const VolumeData data = load_volume(md.vdb, desc_.source, medium_where(md.name));
       grids_.push_back(std::make_unique<GridMedium>(data, md.vdb));

@@ -49,6 +49,20 @@ enum class DistanceSampling {
 };
 enum class MisHeuristic { Balance, Power };
 
+/// How a medium's direct light from point and spot lights is estimated along each ray segment.
+enum class ConnectionSampling {
+  Collision,    ///< next-event estimation at the sampled collisions (default)
+  Equiangular,  ///< a vertex per segment, uniform in the angle seen from the light (Kulla & Fajardo 2012)
+  LineToPoint,  ///< a vertex per segment, uniform in connection time (seed 000 Sec. 5.2)
+  Mis           ///< line-to-point and equiangular, one vertex each, balance heuristic
+};
+
+/// How the next direction is chosen at a collision in a medium.
+enum class DirectionSampling {
+  Phase,   ///< the phase function
+  Angular  ///< half phase, half angular time sampling towards a point or spot light (Sec. 5.3)
+};
+
 /// Affine placement applied after a volume's own index-to-world transform:
 /// scale, then rotate about x, y, z (degrees, in that order), then translate.
 struct TransformDesc {
@@ -80,6 +94,8 @@ struct MediumDesc {
   DistanceSampling sampling = DistanceSampling::Mfp;
   double time_uniform_rate = 0.0;      ///< lambda, per mm of optical path length; 0 = automatic
   MisHeuristic mis_heuristic = MisHeuristic::Balance;
+  ConnectionSampling connection = ConnectionSampling::Collision;
+  DirectionSampling direction = DirectionSampling::Phase;
 };
 
 struct ShapeDesc {

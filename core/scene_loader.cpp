@@ -594,8 +594,9 @@ class Loader {
   void media(const Json& v, SceneDesc& scene) const {
     const std::string p = "/media";
     object(v, p);
-    const Keys common = {"type", "g", "eta", "distance_sampling", "time_uniform_rate",
-                         "mis_heuristic"};
+    const Keys common = {"type",          "g",                   "eta",
+                         "distance_sampling", "time_uniform_rate", "mis_heuristic",
+                         "connection_sampling", "direction_sampling"};
     const Keys homogeneous = {"sigma_a", "sigma_s"};
     const Keys vdb = {"file",        "density_grid", "sigma_t_scale", "albedo",
                       "albedo_grid", "eta_grid",     "interpolation", "transform"};
@@ -623,6 +624,7 @@ class Loader {
       // A VDB medium's constant eta also serves the dielectric-interface check on shapes.
       m.vdb.eta = m.medium.eta;
       distance_sampling(o, mp, m);
+      connection_sampling(o, mp, m);
       scene.media.push_back(m);
     }
   }
@@ -662,6 +664,21 @@ class Loader {
   }
 
   // Distance-sampling keys, valid for every medium type.
+  void connection_sampling(const Json& o, const std::string& mp, MediumDesc& m) const {
+    if (const Json* c = find(o, "connection_sampling")) {
+      const std::string v = choice(*c, at(mp, "connection_sampling"),
+                                   {"collision", "equiangular", "line_to_point", "mis"});
+      m.connection = v == "collision"       ? ConnectionSampling::Collision
+                     : v == "equiangular"   ? ConnectionSampling::Equiangular
+                     : v == "line_to_point" ? ConnectionSampling::LineToPoint
+                                            : ConnectionSampling::Mis;
+    }
+    if (const Json* d = find(o, "direction_sampling"))
+      m.direction = choice(*d, at(mp, "direction_sampling"), {"phase", "angular"}) == "phase"
+                        ? DirectionSampling::Phase
+                        : DirectionSampling::Angular;
+  }
+
   void distance_sampling(const Json& o, const std::string& mp, MediumDesc& m) const {
     const Json* s = find(o, "distance_sampling");
     if (s) {

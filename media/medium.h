@@ -14,6 +14,8 @@ struct Medium {
   HomogeneousMedium homogeneous;     ///< coefficients of a homogeneous medium; g for both types
   const GridMedium* grid = nullptr;  ///< owned by the Scene
   DistanceStrategy strategy;
+  ConnectionSampling connection = ConnectionSampling::Collision;
+  DirectionSampling direction = DirectionSampling::Phase;
 
   double g() const { return homogeneous.g; }
   /// Whether light can scatter or be absorbed here (a clear region needs no distance sampling).

@@ -422,6 +422,11 @@ TEST_CASE("cli: bad input exits 2 with a one-line message and writes nothing", "
        {"render", "no_such_scene.json", "--out", out}, {"no_such_scene.json"}},
       {"two scene files: the second silently ignored",
        {"render", good, "other.json", "--out", out}, {"other.json"}},
+      {"unknown --connection-sampling accepted",
+       {"render", good, "--connection-sampling", "line-to-point", "--out", out},
+       {"--connection-sampling", "line-to-point"}},
+      {"unknown --direction-sampling accepted",
+       {"render", good, "--direction-sampling", "angle", "--out", out}, {"--direction-sampling", "angle"}},
       {"unknown --reconstruction falling back to the histogram",
        {"render", good, "--reconstruction", "kde", "--out", out}, {"--reconstruction", "kde"}},
       {"kernel settings silently ignored by a histogram render",
@@ -470,6 +475,9 @@ TEST_CASE("cli: bad input exits 2 with a one-line message and writes nothing", "
             scene_with("alpha.json",
                        [](json& s) { s["time"]["reconstruction"] = {{"type", "kernel"}, {"alpha", 1.5}}; }),
             {"/time/reconstruction/alpha", "1.5"});
+  bad_scene("an unknown connection sampling accepted",
+            scene_with("conn.json", [](json& s) { s["media"]["fog"]["connection_sampling"] = "ltp"; }),
+            {"/media/fog/connection_sampling", "ltp"});
   bad_scene("a misspelt reconstruction accepted",
             scene_with("recon.json", [](json& s) { s["time"]["reconstruction"] = "kernal"; }),
             {"/time/reconstruction", "kernal"});

@@ -581,8 +581,11 @@ TEST_CASE("scene loader: vdb media and distance-sampling keys", "[scene_loader]"
     "type": "vdb", "file": "cloud.vdb", "density_grid": "smoke", "sigma_t_scale": 0.5,
     "albedo_grid": "a", "eta_grid": "e", "eta": 1.2, "g": 0.4, "interpolation": "trilinear",
     "transform": {"translate": [1, 2, 3], "rotate": [0, 90, 0], "scale": 2},
-    "distance_sampling": "mis", "time_uniform_rate": 0.25, "mis_heuristic": "power"})"));
+    "distance_sampling": "mis", "time_uniform_rate": 0.25, "mis_heuristic": "power",
+    "connection_sampling": "mis", "direction_sampling": "angular"})"));
   j["media"]["fog"]["distance_sampling"] = "time_uniform";
+  j["media"]["fog"]["connection_sampling"] = "line_to_point";
+  j["media"]["air"]["connection_sampling"] = "equiangular";
   j["media"]["fog"]["time_uniform_rate"] = 3;
   j["media"]["air"]["distance_sampling"] = "mfp";
   j["medium"] = "cloud";
@@ -608,6 +611,11 @@ TEST_CASE("scene loader: vdb media and distance-sampling keys", "[scene_loader]"
   CHECK(m.sampling == femto::DistanceSampling::Mis);
   CHECK(m.time_uniform_rate == 0.25);
   CHECK(m.mis_heuristic == femto::MisHeuristic::Power);
+  CHECK(m.connection == femto::ConnectionSampling::Mis);
+  CHECK(m.direction == femto::DirectionSampling::Angular);
+  CHECK(s.media[0].connection == femto::ConnectionSampling::LineToPoint);
+  CHECK(s.media[0].direction == femto::DirectionSampling::Phase);
+  CHECK(s.media[1].connection == femto::ConnectionSampling::Equiangular);
   CHECK(s.media[0].type == femto::MediumDesc::Type::Homogeneous);
   CHECK(s.media[0].sampling == femto::DistanceSampling::TimeUniform);
   CHECK(s.media[0].time_uniform_rate == 3);
@@ -626,6 +634,8 @@ TEST_CASE("scene loader: vdb media and distance-sampling keys", "[scene_loader]"
   CHECK(md.vdb.transform.scale.y == 1);
   CHECK(md.time_uniform_rate == 0.0);  // automatic
   CHECK(md.mis_heuristic == femto::MisHeuristic::Balance);
+  CHECK(md.connection == femto::ConnectionSampling::Collision);
+  CHECK(md.direction == femto::DirectionSampling::Phase);
 
   // A constant albedo; a dielectric around a VDB medium of the same eta.
   Json c = minimal_vdb();

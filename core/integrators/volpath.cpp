@@ -47,6 +47,15 @@ VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& f
   // Contributions are deposited with up to 8 sigma of pulse spread (see TemporalFilter).
   t_cut_ = filter.axis().t_end_ps() - scene.lights().min_offset_ps() +
            8.0 * scene.lights().max_sigma_ps();
+  const LightSet& lights = scene.lights();
+  double total = 0;
+  for (int i = 0; i < lights.count(); ++i)
+    if (is_point_like(lights.light(i))) {
+      point_lights_.push_back(i);
+      point_pmf_.push_back(lights.pmf(i));
+      total += lights.pmf(i);
+    }
+  for (double& p : point_pmf_) p /= total;
 }
 
 void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
@@ -60,7 +69,7 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
 }
 
 VolPathIntegrator::MediumSample VolPathIntegrator::sample_medium(const Medium& med, const Ray& ray, double s_max,
-                                              Rng& rng) const {
+                                              Rng& rng, double u_main) const {
   MediumSample out;
   DistanceEvent& ev = out.main;
   if (!med.interacts()) {
@@ -68,7 +77,7 @@ VolPathIntegrator::MediumSample VolPathIntegrator::sample_medium(const Medium& m
     ev.opl = med.homogeneous.eta * s_max;
     return out;
   }
-  const double u1 = rng.uniform();
+  const double u1 = u_main >= 0.0 ? u_main : rng.uniform();
   if (med.type == Medium::Type::Homogeneous) {
     const HomogeneousMedium& h = med.homogeneous;
     if (med.strategy.kind == DistanceSampling::Mfp || !(h.sigma_s > 0)) {
@@ -106,18 +115,22 @@ VolPathIntegrator::MediumSample VolPathIntegrator::finish_sample(Segments& segme
 }
 
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
-                                               const RGB& beta, double t, Rng& rng,
-                                               PixelAccumulator& acc, PathStats& stats) const {
+                                               const RGB& beta, double t, const DirectionMix* mix,
+                                               bool skip_point_lights, Rng& rng, PixelAccumulator& acc,
+                                               PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
   const double u1 = rng.uniform(), u2 = rng.uniform();
   LightSample ls;
-  if (li < 0 || beta.is_black() || !lights.sample(li, x, u1, u2, ls)) return;
+  if (li < 0 || beta.is_black()) return;
+  if (skip_point_lights && is_point_like(lights.light(li))) return;  // estimate_segment's share
+  if (!lights.sample(li, x, u1, u2, ls)) return;
   const double f = hg_eval(dot(d, ls.wi), g);
   double Tr, dt;
   if (!(f > 0) || !connect(x, m, ls.wi, ls.dist, Tr, dt, stats)) return;
-  const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, f);
+  const double p_dir = ls.is_delta ? 0.0 : mix ? direction_pdf(*mix, x, d, g, ls.wi) : f;
+  const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, p_dir);
   const Light& L = lights.light(li);
   deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(), beta * ls.Li * (f * Tr * w / (pmf * ls.pdf)), acc,
           stats);
@@ -191,21 +204,34 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   Vec3 prev_p = ray.o;
   int depth = 0;
   int null_crossings = 0;
+  double u_next = -1.0;       // pre-drawn distance uniform for the next segment (angular sampling)
 
   for (;;) {
     SurfaceHit hit;
     const bool found = scene_.geometry().intersect(ray, 0.0, kInf, hit);
     const double s_surf = found ? hit.s : kInf;
     const Medium& med = media[static_cast<size_t>(m)];
-    const MediumSample ms = sample_medium(med, ray, s_surf, rng);
+    const MediumSample ms = sample_medium(med, ray, s_surf, rng, u_next);
     const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
+    const bool segment_connections = med.connection != ConnectionSampling::Collision && !point_lights_.empty();
+    if (segment_connections && depth < max_depth_)
+      estimate_segment(med, m, ray, s_surf, beta, t, t_dropped, rng, acc, stats);
+    // Angular direction sampling: the next segment's distance draw is made now so that every
+    // strategy's MIS weight at this segment's vertices sees the same r_aux.
+    const bool angular = med.direction == DirectionSampling::Angular && !point_lights_.empty() &&
+                         ms.main.collided && depth < max_depth_;
+    u_next = angular ? rng.uniform() : -1.0;
+    const double t_main = t + ms.main.opl * t_dropped;
+    const DirectionMix mix_main = angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next) : DirectionMix{};
     if (ms.extra.collided && depth < max_depth_) {
       // The time-uniform collision of MIS: next-event estimation only (the path goes on from
       // the mean-free-path collision).
       const Vec3 x2 = ray.at(ms.extra.s);
       const double albedo2 = med.type == Medium::Type::Grid ? med.grid->albedo_at(x2) : med.homogeneous.albedo();
-      estimate_direct_medium(x2, m, ray.d, med.g(), beta * (albedo2 * ms.extra_nee_weight),
-                             t + ms.extra.opl * t_dropped, rng, acc, stats);
+      const double t2 = t + ms.extra.opl * t_dropped;
+      const DirectionMix mix2 = angular ? direction_mix(med, x2, t2, u_next) : DirectionMix{};
+      estimate_direct_medium(x2, m, ray.d, med.g(), beta * (albedo2 * ms.extra_nee_weight), t2,
+                             angular ? &mix2 : nullptr, segment_connections, rng, acc, stats);
     }
     const DistanceEvent& ev = ms.main;
     if (!ev.collided && !found) break;  // escaped to infinity
@@ -225,13 +251,14 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const Vec3 x = ray.at(ev.s);
       beta *= med.type == Medium::Type::Grid ? med.grid->albedo_at(x) : med.homogeneous.albedo();
       if (beta.is_black()) break;
-      estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t, rng, acc, stats);
-      // Phase sampling: HG is sampled exactly, so the weight f / pdf is 1.
-      const PhaseSample ps = hg_sample(ray.d, med.g(), rng.uniform(), rng.uniform());
-      prev_pdf = ps.value;
+      estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t, angular ? &mix_main : nullptr,
+                             segment_connections, rng, acc, stats);
+      Vec3 wi;
+      beta *= sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone
+      if (beta.is_black()) break;
       specular = false;
       prev_p = x;
-      ray = {x, ps.dir};
+      ray = {x, wi};
       continue;
     }
 

@@ -1,0 +1,168 @@
+// Time-targeted sampling in media for the path tracer (seed 000 Sec. 5.2-5.3): segment
+// connections to point and spot lights (equiangular, line-to-point, or both by MIS) and angular
+// direction sampling mixed with phase sampling.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/constants.h"
+#include "core/integrators/volpath.h"
+#include "media/phase_hg.h"
+#include "samplers/angular.h"
+#include "samplers/equiangular.h"
+#include "samplers/line_to_point.h"
+
+namespace femto {
+
+namespace {
+/// Connection-time window (ps) that keeps a contribution of light `L` inside the film window,
+/// for a path that has used time t; pulse tails widen it by 8 sigma.
+void connection_window(const TimeAxis& axis, const Light& L, double t, double& t_a, double& t_b) {
+  const double spread = 8.0 * L.pulse.sigma_ps();
+  t_a = axis.t_start_ps - t - L.pulse.offset_ps - spread;
+  t_b = axis.t_end_ps() - t - L.pulse.offset_ps + spread;
+}
+}  // namespace
+
+VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& med, const Vec3& x, double t,
+                                                                 double u) const {
+  DirectionMix mix;
+  mix.u = u;
+  mix.t = t;
+  mix.eta = med.eta_at(x);
+  // The segment length the next distance draw u gives at x's own coefficients.
+  const double e = -std::log1p(-u);
+  if (med.strategy.kind == DistanceSampling::TimeUniform) {
+    mix.r_aux = e / (med.strategy.lambda * mix.eta);
+  } else {
+    const double sigma_t = med.type == Medium::Type::Grid ? med.grid->sigma_t_at(x) : med.homogeneous.sigma_t();
+    mix.r_aux = sigma_t > 0 ? e / sigma_t : std::numeric_limits<double>::infinity();
+  }
+  if (!std::isfinite(mix.r_aux)) return mix;
+  const LightSet& lights = scene_.lights();
+  for (size_t k = 0; k < point_lights_.size(); ++k) {
+    const Light& L = lights.light(point_lights_[k]);
+    double t_a, t_b;
+    connection_window(filter_.axis(), L, t, t_a, t_b);
+    const AngularTimeSampler sampler(mix.r_aux, length(L.position - x), mix.eta);
+    if (sampler.window(t_a, t_b).valid) mix.valid_pmf += point_pmf_[k];
+  }
+  mix.active = mix.valid_pmf > 0;
+  return mix;
+}
+
+double VolPathIntegrator::angular_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& w) const {
+  const LightSet& lights = scene_.lights();
+  double pdf = 0;
+  for (size_t k = 0; k < point_lights_.size(); ++k) {
+    const Light& L = lights.light(point_lights_[k]);
+    double t_a, t_b;
+    connection_window(filter_.axis(), L, mix.t, t_a, t_b);
+    const Vec3 to = L.position - x;
+    const double l = length(to);
+    const AngularTimeSampler sampler(mix.r_aux, l, mix.eta);
+    const AngularTimeSampler::Window win = sampler.window(t_a, t_b);
+    if (!win.valid || !(l > 0)) continue;
+    pdf += point_pmf_[k] / mix.valid_pmf *
+           sampler.pdf_solid_angle(win, AngularTimeSampler::one_minus_cos(to / l, w));
+  }
+  return pdf;
+}
+
+double VolPathIntegrator::direction_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g,
+                                        const Vec3& w) const {
+  const double phase = hg_eval(dot(d, w), g);
+  return mix.active ? 0.5 * phase + 0.5 * angular_pdf(mix, x, w) : phase;
+}
+
+double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g,
+                                           Rng& rng, Vec3& w, double& pdf) const {
+  if (!mix.active) {
+    const PhaseSample ps = hg_sample(d, g, rng.uniform(), rng.uniform());
+    w = ps.dir;
+    pdf = ps.value;
+    return 1.0;  // HG is sampled exactly
+  }
+  const double u_pick = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+  if (u_pick < 0.5) {
+    w = hg_sample(d, g, u1, u2).dir;
+  } else {
+    // A point light among those whose window is reachable, in proportion to power.
+    const LightSet& lights = scene_.lights();
+    double u = (u_pick - 0.5) * 2.0 * mix.valid_pmf;
+    size_t chosen = point_lights_.size();
+    AngularTimeSampler::Window win;
+    for (size_t k = 0; k < point_lights_.size(); ++k) {
+      const Light& L = lights.light(point_lights_[k]);
+      double t_a, t_b;
+      connection_window(filter_.axis(), L, mix.t, t_a, t_b);
+      const AngularTimeSampler::Window wk =
+          AngularTimeSampler(mix.r_aux, length(L.position - x), mix.eta).window(t_a, t_b);
+      if (!wk.valid) continue;
+      chosen = k;
+      win = wk;
+      if (u < point_pmf_[k]) break;
+      u -= point_pmf_[k];
+    }
+    const Light& L = lights.light(point_lights_[chosen]);
+    const Vec3 to = L.position - x;
+    const double l = length(to);
+    w = AngularTimeSampler(mix.r_aux, l, mix.eta).sample_direction(to / l, win, u1, u2);
+  }
+  pdf = direction_pdf(mix, x, d, g, w);
+  return pdf > 0 ? hg_eval(dot(d, w), g) / pdf : 0.0;
+}
+
+void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ray, double s_surf, const RGB& beta,
+                                         double t, double t_factor, Rng& rng, PixelAccumulator& acc,
+                                         PathStats& stats) const {
+  const LightSet& lights = scene_.lights();
+  double pmf = 0;
+  const int li = lights.pick(rng.uniform(), pmf);
+  const double u_e = rng.uniform(), u_l = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+  if (li < 0 || beta.is_black() || !med.interacts()) return;
+  const Light& L = lights.light(li);
+  if (!is_point_like(L)) return;  // area lights and lasers: next-event estimation at collisions
+  const Vec3& p = L.position;
+  // No vertex beyond the path cut-off: its optical path length alone would exceed it (eta >= 1);
+  // on an unwarped camera segment only the connection counts, at least s - |p - o|.
+  const double reach = kSpeedOfLight * (t_cut_ - t) + (t_factor > 0 ? 0.0 : length(p - ray.o));
+  const double s_end = std::min(s_surf, reach);
+  if (!(s_end > 0)) return;
+
+  const ConnectionSampling kind = med.connection;
+  const bool use_eq = kind == ConnectionSampling::Equiangular || kind == ConnectionSampling::Mis;
+  const bool use_lp = kind == ConnectionSampling::LineToPoint || kind == ConnectionSampling::Mis;
+  const EquiangularSampler eq(ray.o, ray.d, p, 0.0, s_end);
+  const double eta0 = med.eta_at(ray.o);
+  const LineToPointSampler lp(ray.o, ray.d, p, eta0);
+  double t_a, t_b;
+  connection_window(filter_.axis(), L, t, t_a, t_b);
+  // Unwarped camera segment: the film time leaves out s, so cover every s whose connection can land.
+  if (!(t_factor > 0)) t_b += eta0 * s_end / kSpeedOfLight;
+  const LineToPointSampler::Window win = lp.window(t_a, t_b, 0.0, s_end);
+  const bool eq_ok = use_eq && eq.valid(), lp_ok = use_lp && win.valid;
+
+  auto contribute = [&](double s) {
+    // Multi-sample balance heuristic: f / (sum of the strategies' densities).
+    const double p_sum = (eq_ok ? eq.pdf(s) : 0.0) + (lp_ok ? lp.pdf(win, s) : 0.0);
+    if (!(p_sum > 0) || !(s < s_end)) return;
+    const Vec3 y = ray.at(s);
+    double tau, opl;
+    segment_integrals(m, ray, s, tau, opl);
+    const double sigma_s = med.type == Medium::Type::Grid ? med.grid->sigma_t_at(y) * med.grid->albedo_at(y)
+                                                          : med.homogeneous.sigma_s;
+    if (!(sigma_s > 0)) return;
+    LightSample ls;
+    if (!lights.sample(li, y, u1, u2, ls)) return;
+    const double f = hg_eval(dot(ray.d, ls.wi), med.g());
+    double Tr, dt;
+    if (!(f > 0) || !connect(y, m, ls.wi, ls.dist, Tr, dt, stats)) return;
+    const double weight = sigma_s * std::exp(-tau) * f * Tr / (p_sum * pmf * ls.pdf);
+    deposit(t + opl * t_factor + dt + L.pulse.offset_ps, L.pulse.sigma_ps(), beta * ls.Li * weight, acc, stats);
+  };
+  if (eq_ok) contribute(eq.sample(u_e));
+  if (lp_ok) contribute(lp.sample(win, u_l));
+}
+
+}  // namespace femto
