@@ -74,6 +74,18 @@ double Args::double_value(double lo, double hi) {
   return x;
 }
 
+uint64_t Args::count_value(double lo, double hi) {
+  const std::string v = value();
+  char* end = nullptr;
+  const double n = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0' || !(n >= lo && n <= hi) || n != std::floor(n)) {
+    char range[96];
+    std::snprintf(range, sizeof range, "expected an integer in [%.15g, %.15g], e.g. 1e5", lo, hi);
+    fail(range, v);
+  }
+  return static_cast<uint64_t>(n);
+}
+
 uint64_t Args::size_value() {
   const std::string v = value();
   char* end = nullptr;

@@ -21,6 +21,8 @@ class Args {
   int64_t int_value(int64_t lo, int64_t hi);
   uint64_t uint_value();
   double double_value(double lo, double hi);
+  /// A whole count in [lo, hi], also written like 1e6.
+  uint64_t count_value(double lo, double hi);
   /// Sizes like 512M, 4G, 1.5GiB or plain bytes.
   uint64_t size_value();
   /// Throws InputError "<command>: <flag>: <problem> (got '<value>')".

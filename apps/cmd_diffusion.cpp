@@ -163,12 +163,7 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
       if (plot_times.empty() || plot_times.size() > 6)
         args.fail("expected 1 to 6 times", plot_text);
     } else if (a == "--photons") {
-      const std::string v = args.value();
-      char* end = nullptr;
-      const double n = std::strtod(v.c_str(), &end);  // accepts 1e6
-      if (v.empty() || *end != '\0' || !(n >= 2 && n <= 1e12) || n != std::floor(n))
-        args.fail("expected an integer in [2, 1e12], e.g. 1e6", v);
-      setup.photons = static_cast<uint64_t>(n);
+      setup.photons = args.count_value(2, 1e12);
     } else if (a == "--seed") {
       setup.seed = args.uint_value();
     } else if (a == "--threads") {

@@ -134,12 +134,7 @@ int cmd_uniformity(const std::vector<std::string>& argv, const std::string& comm
       else
         args.fail("expected connection or vertices", v);
     } else if (a == "--samples") {
-      const std::string v = args.value();
-      char* end = nullptr;
-      const double n = std::strtod(v.c_str(), &end);  // accepts 1e5
-      if (v.empty() || *end != '\0' || !(n >= 1 && n <= 1e7) || n != std::floor(n))
-        args.fail("expected an integer in [1, 1e7], e.g. 1e5", v);
-      c.samples = static_cast<uint64_t>(n);
+      c.samples = args.count_value(1, 1e7);
     } else if (a == "--seed") {
       c.seed = args.uint_value();
     } else if (a == "--bins") {

@@ -74,4 +74,11 @@ inline MeanSE mean_se(const std::vector<double>& v) {
   return {m, std::sqrt(var / static_cast<double>(v.size()))};
 }
 
+/// Mean and standard error over batches of bin i of the first pixel (red channel).
+inline MeanSE bin_mean_se(const std::vector<TransientFilm>& films, int i) {
+  std::vector<double> v;
+  for (const auto& f : films) v.push_back(f.transient()[3 * static_cast<size_t>(i)]);
+  return mean_se(v);
+}
+
 }  // namespace femto::test

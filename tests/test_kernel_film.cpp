@@ -134,9 +134,7 @@ TEST_CASE("kernel film equals its exact expectation on single scattering", "[ker
     };
     const double s0 = p.s_of_time(b0 - T1), s1 = p.s_of_time(b1 + T1);
     const double expected = s1 > s0 ? stats::adaptive_simpson(integrand, s0, s1, 1e-11) : 0.0;
-    std::vector<double> v;
-    for (const auto& f : films) v.push_back(f.transient()[3 * i]);
-    const MeanSE m = mean_se(v);
+    const MeanSE m = bin_mean_se(films, i);
     INFO("bin " << i << ": " << m.mean << " +- " << m.se << ", expected " << expected << ", histogram answer "
                 << p.bin(i));
     CHECK(std::abs(m.mean - expected) < 4.0 * m.se + 1e-9 * expected);
@@ -156,9 +154,7 @@ TEST_CASE("progressive kernel bias shrinks as samples grow", "[kernel_film]") {
     const auto films = render_batches(d, spp, batches, /*max_depth=*/1);
     double b2 = 0, norm = 0;
     for (int i = 0; i < p.axis.bins; ++i) {
-      std::vector<double> v;
-      for (const auto& f : films) v.push_back(f.transient()[3 * i]);
-      const MeanSE m = mean_se(v);
+      const MeanSE m = bin_mean_se(films, i);
       const double e = p.bin(i);
       b2 += (m.mean - e) * (m.mean - e) - m.se * m.se;  // unbiased estimate of bias^2
       norm += e * e;

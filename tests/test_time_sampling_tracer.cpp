@@ -74,9 +74,7 @@ TEST_CASE("segment connections match the single-scattering answer bin by bin", "
     const auto films = render_batches(d, 2000, 16, /*max_depth=*/1);
     int checked = 0;
     for (int i = 0; i < p.axis.bins; ++i) {
-      std::vector<double> v;
-      for (const auto& f : films) v.push_back(f.transient()[3 * i]);
-      const MeanSE m = mean_se(v);
+      const MeanSE m = bin_mean_se(films, i);
       const double expected = p.bin(i);
       INFO(name_of(c) << " bin " << i << ": " << m.mean << " +- " << m.se << " expected " << expected);
       CHECK(std::abs(m.mean - expected) <= 4.0 * m.se + 1e-9 * expected);

@@ -204,9 +204,7 @@ TEST_CASE("single scattering from a point light matches 1-D quadrature bin by bi
   const auto films = render_batches(d, 20000, batches, /*max_depth=*/1);
   int checked = 0;
   for (int i = 0; i < p.axis.bins; ++i) {
-    std::vector<double> v;
-    for (const auto& f : films) v.push_back(f.transient()[3 * i]);
-    const MeanSE m = mean_se(v);
+    const MeanSE m = bin_mean_se(films, i);
     const double expected = p.bin(i);
     INFO("bin " << i << ": " << m.mean << " +- " << m.se << " expected " << expected);
     if (expected == 0.0) {
