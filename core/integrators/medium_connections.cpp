@@ -124,9 +124,10 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
   const Light& L = lights.light(li);
   if (!is_point_like(L)) return;  // area lights and lasers: next-event estimation at collisions
   const Vec3& p = L.position;
-  // No vertex beyond the path cut-off: its optical path length alone would exceed it (eta >= 1);
-  // on an unwarped camera segment only the connection counts, at least s - |p - o|.
-  const double reach = kSpeedOfLight * (t_cut_ - t) + (t_factor > 0 ? 0.0 : length(p - ray.o));
+  // No vertex whose path passes the cut-off: with eta >= 1 the time of s and its connection is at
+  // least (s + d) / c with d >= s - |p - o|; an unwarped camera segment counts only d.
+  const double l = length(p - ray.o), budget = kSpeedOfLight * (t_cut_ - t);
+  const double reach = t_factor > 0 ? 0.5 * (budget + l) : budget + l;
   const double s_end = std::min(s_surf, reach);
   if (!(s_end > 0)) return;
 
