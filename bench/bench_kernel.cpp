@@ -192,10 +192,8 @@ std::vector<double> render_pixel(const Scene& scene, int spp, uint64_t seed, dou
   return v;
 }
 
-// The same pixel traced sample by sample through the film's public pieces (camera ray, sample
-// stream, integrator, PixelAccumulator, bandwidth schedule), in the order render() uses, but
-// keeping the double-precision sums the film rounds to float. Bit-identical float bins against
-// render() show that these sums are render()'s own.
+// The same pixel through render_pixel(), keeping the double-precision sums the film rounds to
+// float. Bit-identical float bins against render() show that these sums are render()'s own.
 struct MirrorPixel {
   PixelAccumulator acc;
   double total = 0.0;  ///< (bins + before + after) / spp, red channel, in double
@@ -205,49 +203,15 @@ MirrorPixel mirror_pixel(const Scene& scene, int spp, uint64_t seed) {
   const TimeAxis axis = scene.desc().time;
   const TemporalFilter filter(axis, rec.type, rec.kernel);
   const VolPathIntegrator integrator(scene, filter, 1);
+  RenderOptions o;
+  o.spp = spp;
+  o.seed = seed;
+  o.max_depth = 1;
   PathStats st;
   MirrorPixel m;
-  PixelAccumulator& acc = m.acc;
-  acc.reset(axis.bins);
-  auto trace_sample = [&](int s) {
-    Rng rng = Rng::for_sample(seed, 0, static_cast<uint64_t>(s));
-    const double fx = rng.uniform(), fy = rng.uniform();
-    acc.sample = s;
-    integrator.trace(scene.camera().generate_ray(fx, fy), rng, acc, st);
-  };
-  if (rec.type == TemporalFilter::Kind::Histogram) {
-    for (int s = 0; s < spp; ++s) trace_sample(s);
-  } else {
-    const int first_pass = rec.bandwidth_ps <= 0.0 ? std::min(spp, rec.first_pass_spp) : 0;
-    acc.kernel = true;
-    acc.fixed_ps = rec.bandwidth_ps;
-    acc.knn = rec.knn;
-    acc.cap_ps = axis.t_end_ps() - axis.t_start_ps;
-    acc.fallback_ps = axis.bin_width_ps;
-    BandwidthSchedule schedule(rec.alpha);
-    const double norm = acc.fixed_ps > 0.0 ? 1.0 : 1.0 / BandwidthSchedule::ratio_at(rec.alpha, std::max(1, first_pass));
-    if (first_pass > 0) {
-      acc.hold = true;
-      for (int s = 0; s < first_pass; ++s) trace_sample(s);
-      acc.hold = false;
-      for (const PixelAccumulator::Held& hd : acc.held) acc.times.push_back(hd.t_ps);
-      std::sort(acc.times.begin(), acc.times.end());
-      for (const PixelAccumulator::Held& hd : acc.held) {
-        while (schedule.j() < hd.sample + 1) schedule.advance();
-        acc.scale = norm * schedule.ratio();
-        acc.add_now(filter, hd.t_ps, hd.sigma_ps, hd.value, acc.bandwidth_at(hd.t_ps));
-      }
-      while (schedule.j() < first_pass + 1) schedule.advance();
-    }
-    for (int s = first_pass; s < spp; ++s) {
-      acc.scale = norm * schedule.ratio();
-      trace_sample(s);
-      schedule.advance();
-    }
-    acc.scale = norm * BandwidthSchedule::ratio_at(rec.alpha, spp);  // the last sample's scale
-  }
-  double sum = acc.before.r + acc.after.r;
-  for (int i = 0; i < axis.bins; ++i) sum += acc.bins[3 * static_cast<size_t>(i)];
+  render_pixel(scene, integrator, filter, o, 0, 0, m.acc, st);
+  double sum = m.acc.before.r + m.acc.after.r;
+  for (int i = 0; i < axis.bins; ++i) sum += m.acc.bins[3 * static_cast<size_t>(i)];
   m.total = sum / spp;
   return m;
 }

@@ -28,6 +28,54 @@ double typical_bandwidth(const PixelAccumulator& acc, const TimeAxis& axis) {
 }
 }  // namespace
 
+void render_pixel(const Scene& scene, const VolPathIntegrator& integrator, const TemporalFilter& filter,
+                  const RenderOptions& opt, int x, int y, PixelAccumulator& acc, PathStats& st) {
+  const Camera& camera = scene.camera();
+  const TimeAxis& axis = filter.axis();
+  const ReconstructionDesc& rec = scene.desc().reconstruction;
+  acc.reset(axis.bins);
+  const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(camera.width()) + static_cast<uint64_t>(x);
+  auto trace_sample = [&](int s) {
+    Rng rng = Rng::for_sample(opt.seed, pixel, static_cast<uint64_t>(s));
+    const double fx = x + rng.uniform(), fy = y + rng.uniform();
+    acc.sample = s;
+    integrator.trace(camera.generate_ray(fx, fy), rng, acc, st);
+  };
+  if (rec.type != TemporalFilter::Kind::Kernel) {
+    for (int s = 0; s < opt.spp; ++s) trace_sample(s);
+    return;
+  }
+  acc.kernel = true;
+  acc.fixed_ps = rec.bandwidth_ps;
+  acc.knn = rec.knn;
+  acc.cap_ps = axis.t_end_ps() - axis.t_start_ps;
+  acc.fallback_ps = axis.bin_width_ps;
+  // First pass: its arrival times set the bandwidth, anchored (r_j / r_P) so that its last
+  // sample uses the k-NN distance itself.
+  const int first_pass = rec.bandwidth_ps <= 0.0 ? std::min(opt.spp, rec.first_pass_spp) : 0;
+  const double norm = first_pass > 0 ? 1.0 / BandwidthSchedule::ratio_at(rec.alpha, first_pass) : 1.0;
+  BandwidthSchedule schedule(rec.alpha);
+  if (first_pass > 0) {
+    acc.hold = true;
+    for (int s = 0; s < first_pass; ++s) trace_sample(s);
+    acc.hold = false;
+    for (const PixelAccumulator::Held& h : acc.held) acc.times.push_back(h.t_ps);
+    std::sort(acc.times.begin(), acc.times.end());
+    for (const PixelAccumulator::Held& h : acc.held) {  // in sample order
+      while (schedule.j() < h.sample + 1) schedule.advance();
+      acc.scale = norm * schedule.ratio();
+      acc.add_now(filter, h.t_ps, h.sigma_ps, h.value, acc.bandwidth_at(h.t_ps));
+    }
+  }
+  while (schedule.j() < first_pass + 1) schedule.advance();
+  for (int s = first_pass; s < opt.spp; ++s) {
+    acc.scale = norm * schedule.ratio();
+    trace_sample(s);
+    schedule.advance();
+  }
+  acc.scale = norm * BandwidthSchedule::ratio_at(rec.alpha, opt.spp);  // the last sample's, for typical_bandwidth
+}
+
 RenderResult render(const Scene& scene, const RenderOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   const Camera& camera = scene.camera();
@@ -37,10 +85,6 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
   const ReconstructionDesc& rec = scene.desc().reconstruction;
   const bool kernel = rec.type == TemporalFilter::Kind::Kernel;
   const TemporalFilter filter(axis, rec.type, rec.kernel);
-  // First pass: its arrival times set the bandwidth, anchored so that its last sample uses it.
-  const int first_pass = kernel && rec.bandwidth_ps <= 0.0 ? std::min(opt.spp, rec.first_pass_spp) : 0;
-  const double first_pass_ratio = BandwidthSchedule::ratio_at(rec.alpha, std::max(1, first_pass));
-  const double last_ratio = BandwidthSchedule::ratio_at(rec.alpha, opt.spp);
   if (kernel) result.final_bandwidth_ps.assign(static_cast<size_t>(W) * static_cast<size_t>(H), 0.0f);
   const VolPathIntegrator integrator(scene, filter, opt.max_depth);
 
@@ -61,47 +105,10 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
         const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
         for (int y = y0; y < y1; ++y) {
           for (int x = x0; x < x1; ++x) {
-            acc.reset(axis.bins);
-            const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(W) + static_cast<uint64_t>(x);
-            auto trace_sample = [&](int s) {
-              Rng rng = Rng::for_sample(opt.seed, pixel, static_cast<uint64_t>(s));
-              const double fx = x + rng.uniform(), fy = y + rng.uniform();
-              acc.sample = s;
-              integrator.trace(camera.generate_ray(fx, fy), rng, acc, st);
-            };
-            if (!kernel) {
-              for (int s = 0; s < opt.spp; ++s) trace_sample(s);
-            } else {
-              acc.kernel = true;
-              acc.fixed_ps = rec.bandwidth_ps;
-              acc.knn = rec.knn;
-              acc.cap_ps = axis.t_end_ps() - axis.t_start_ps;
-              acc.fallback_ps = axis.bin_width_ps;
-              BandwidthSchedule schedule(rec.alpha);
-              // Adaptive: r_j / r_P, so the first pass's last sample uses the k-NN distance itself.
-              const double norm = acc.fixed_ps > 0.0 ? 1.0 : 1.0 / first_pass_ratio;
-              if (first_pass > 0) {
-                acc.hold = true;
-                for (int s = 0; s < first_pass; ++s) trace_sample(s);
-                acc.hold = false;
-                for (const PixelAccumulator::Held& h : acc.held) acc.times.push_back(h.t_ps);
-                std::sort(acc.times.begin(), acc.times.end());
-                for (const PixelAccumulator::Held& h : acc.held) {  // in sample order
-                  while (schedule.j() < h.sample + 1) schedule.advance();
-                  acc.scale = norm * schedule.ratio();
-                  acc.add_now(filter, h.t_ps, h.sigma_ps, h.value, acc.bandwidth_at(h.t_ps));
-                }
-                while (schedule.j() < first_pass + 1) schedule.advance();
-              }
-              for (int s = first_pass; s < opt.spp; ++s) {
-                acc.scale = norm * schedule.ratio();
-                trace_sample(s);
-                schedule.advance();
-              }
-              acc.scale = norm * last_ratio;
-              result.final_bandwidth_ps[static_cast<size_t>(pixel)] =
+            render_pixel(scene, integrator, filter, opt, x, y, acc, st);
+            if (kernel)
+              result.final_bandwidth_ps[static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x)] =
                   static_cast<float>(typical_bandwidth(acc, axis));
-            }
             result.film.set_pixel(x, y, acc.bins.data(), acc.before, acc.after, opt.spp);
           }
           progress.add(static_cast<uint64_t>(x1 - x0) * static_cast<uint64_t>(opt.spp));

@@ -26,6 +26,11 @@ struct RenderResult {
   std::vector<float> final_bandwidth_ps;
 };
 
+/// Traces the spp samples of pixel (x, y) into `acc` (reset first) with the scene's temporal
+/// reconstruction: the whole per-pixel estimator, in double precision, before the film's float.
+void render_pixel(const Scene& scene, const VolPathIntegrator& integrator, const TemporalFilter& filter,
+                  const RenderOptions& opt, int x, int y, PixelAccumulator& acc, PathStats& stats);
+
 /// Traces spp paths per pixel and reconstructs time with the scene's `reconstruction`. The result is bit-identical for a given seed whatever the thread
 /// count: every sample has its own random stream and each pixel sums its samples in order.
 RenderResult render(const Scene& scene, const RenderOptions& options);
