@@ -74,6 +74,35 @@ double Args::double_value(double lo, double hi) {
   return x;
 }
 
+double Args::number_in(double lo, double hi, bool lo_open, bool hi_open, const std::string& range) {
+  const std::string v = value();
+  char* end = nullptr;
+  const double x = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0' || !std::isfinite(x)) fail("expected a number", v);
+  if (x < lo || x > hi || (lo_open && x == lo) || (hi_open && x == hi)) fail("must be " + range, v);
+  return x;
+}
+
+Vec3 Args::xyz_value(bool nonzero) {
+  const std::string v = value();
+  double xyz[3];
+  size_t n = 0, start = 0;
+  for (;;) {
+    const size_t comma = v.find(',', start);
+    const std::string item = v.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(x) || n == 3) fail("expected X,Y,Z in mm", v);
+    xyz[n++] = x;
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (n != 3) fail("expected X,Y,Z in mm", v);
+  const Vec3 p(xyz[0], xyz[1], xyz[2]);
+  if (nonzero && !(length(p) > 0)) fail("must be a non-zero direction", v);
+  return p;
+}
+
 uint64_t Args::count_value(double lo, double hi) {
   const std::string v = value();
   char* end = nullptr;

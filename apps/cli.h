@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "core/vec3.h"
+
 namespace femto::cli {
 
 /// Walks argv-style arguments; `value()` takes the next one as the current flag's value,
@@ -21,6 +23,10 @@ class Args {
   int64_t int_value(int64_t lo, int64_t hi);
   uint64_t uint_value();
   double double_value(double lo, double hi);
+  /// A number between lo and hi (each end open or closed); `range` completes "must be ...".
+  double number_in(double lo, double hi, bool lo_open, bool hi_open, const std::string& range);
+  /// "X,Y,Z" in mm; `nonzero` rejects the zero vector (directions).
+  Vec3 xyz_value(bool nonzero = false);
   /// A whole count in [lo, hi], also written like 1e6.
   uint64_t count_value(double lo, double hi);
   /// Sizes like 512M, 4G, 1.5GiB or plain bytes.

@@ -71,16 +71,6 @@ const char* kDiffusionHelp =
 
 
 // A number from the current flag's value, with a message naming the flag and the value.
-double number(cli::Args& args, double lo, double hi, bool lo_open, bool hi_open,
-              const char* range) {
-  const std::string v = args.value();
-  char* end = nullptr;
-  const double x = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end != '\0' || !std::isfinite(x)) args.fail("expected a number", v);
-  if (x < lo || x > hi || (lo_open && x == lo) || (hi_open && x == hi))
-    args.fail(std::string("must be ") + range, v);
-  return x;
-}
 
 int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& command_line) {
   std::vector<std::string> argv = argv_in;
@@ -105,29 +95,19 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
       std::fputs(kDiffusionHelp, stdout);
       return 0;
     } else if (a == "--sigma-s") {
-      setup.medium.sigma_s = number(args, 0, 1e6, false, false, "in [0, 1e6] (1/mm)");
+      setup.medium.sigma_s = args.number_in(0, 1e6, false, false, "in [0, 1e6] (1/mm)");
     } else if (a == "--sigma-a") {
-      setup.medium.sigma_a = number(args, 0, 1e6, false, false, "in [0, 1e6] (1/mm)");
+      setup.medium.sigma_a = args.number_in(0, 1e6, false, false, "in [0, 1e6] (1/mm)");
     } else if (a == "--g") {
-      setup.medium.g = number(args, -1, 1, true, true, "in (-1, 1)");
+      setup.medium.g = args.number_in(-1, 1, true, true, "in (-1, 1)");
     } else if (a == "--eta") {
-      setup.medium.eta = number(args, 1, 100, false, false, "in [1, 100]");
+      setup.medium.eta = args.number_in(1, 100, false, false, "in [1, 100]");
     } else if (a == "--scene") {
       scene_path = args.value();
     } else if (a == "--medium") {
       medium_name = args.value();
     } else if (a == "--at") {
-      const std::string v = args.value();
-      std::stringstream ss(v);
-      std::vector<double> xyz;
-      for (std::string item; std::getline(ss, item, ',');) {
-        char* end = nullptr;
-        const double x = std::strtod(item.c_str(), &end);
-        if (item.empty() || *end != '\0' || !std::isfinite(x)) args.fail("expected X,Y,Z in mm", v);
-        xyz.push_back(x);
-      }
-      if (xyz.size() != 3) args.fail("expected X,Y,Z in mm", v);
-      at = Vec3(xyz[0], xyz[1], xyz[2]);
+      at = args.xyz_value();
     } else if (a == "--absorption") {
       absorption_given = true;
       const std::string v = args.value();
@@ -138,17 +118,17 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
       else
         args.fail("expected weighted or analog", v);
     } else if (a == "--t-start") {
-      t_start = number(args, 0, 1e9, false, false, "in [0, 1e9] ps");
+      t_start = args.number_in(0, 1e9, false, false, "in [0, 1e9] ps");
     } else if (a == "--t-end") {
-      t_end = number(args, 0, 1e9, true, false, "in (0, 1e9] ps");
+      t_end = args.number_in(0, 1e9, true, false, "in (0, 1e9] ps");
     } else if (a == "--t-bins") {
       t_bins = static_cast<int>(args.int_value(1, 100000));
     } else if (a == "--r-max") {
-      r_max = number(args, 0, 1e9, true, false, "in (0, 1e9] mm");
+      r_max = args.number_in(0, 1e9, true, false, "in (0, 1e9] mm");
     } else if (a == "--r-bins") {
       r_bins = static_cast<int>(args.int_value(1, 100000));
     } else if (a == "--threshold") {
-      threshold = number(args, 0, 1, true, true, "in (0, 1)");
+      threshold = args.number_in(0, 1, true, true, "in (0, 1)");
     } else if (a == "--plot-times") {
       plot_text = args.value();
       plot_times.clear();

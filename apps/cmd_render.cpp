@@ -157,8 +157,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       else args.fail("expected perlin or epanechnikov", v);
       if (kernel_flag.empty()) kernel_flag = a;
     } else if (a == "--alpha") {
-      alpha = args.double_value(0.0, 1.0);
-      if (!(*alpha > 0.0)) args.fail("must be in (0, 1]", std::to_string(*alpha));
+      alpha = args.number_in(0.0, 1.0, true, false, "in (0, 1]");
       if (kernel_flag.empty()) kernel_flag = a;
     } else if (a == "--knn") {
       knn = static_cast<int>(args.int_value(1, 100000));
@@ -167,8 +166,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       first_pass_spp = static_cast<int>(args.int_value(1, 1000000));
       if (kernel_flag.empty()) kernel_flag = a;
     } else if (a == "--bandwidth") {
-      bandwidth = args.double_value(0.0, 1e12);
-      if (!(*bandwidth > 0.0)) args.fail("must be > 0 ps", std::to_string(*bandwidth));
+      bandwidth = args.number_in(0.0, 1e12, true, false, "in (0, 1e12] ps");
       if (kernel_flag.empty()) kernel_flag = a;
     } else if (a == "--max-depth") {
       max_depth = static_cast<int>(args.int_value(1, 1000000));

@@ -59,33 +59,6 @@ const char* kUniformityHelp =
     "uniform: and every strategy passed), 1 a strategy failed under --expect uniform or another\n"
     "failure, 2 bad flags (nothing written).\n";
 
-double number(cli::Args& args, double lo, double hi, bool lo_open, const char* range,
-              bool hi_open = false) {
-  const std::string v = args.value();
-  char* end = nullptr;
-  const double x = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end != '\0' || !std::isfinite(x)) args.fail("expected a number", v);
-  if (x < lo || x > hi || (lo_open && x == lo) || (hi_open && x == hi))
-    args.fail(std::string("must be ") + range, v);
-  return x;
-}
-
-Vec3 vec3(cli::Args& args, bool nonzero = false) {
-  const std::string v = args.value();
-  std::stringstream ss(v);
-  std::vector<double> xyz;
-  for (std::string item; std::getline(ss, item, ',');) {
-    char* end = nullptr;
-    const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(x)) args.fail("expected X,Y,Z in mm", v);
-    xyz.push_back(x);
-  }
-  if (xyz.size() != 3 || (!v.empty() && v.back() == ',')) args.fail("expected X,Y,Z in mm", v);
-  const Vec3 p(xyz[0], xyz[1], xyz[2]);
-  if (nonzero && !(length(p) > 0)) args.fail("must be a non-zero direction", v);
-  return p;
-}
-
 int cmd_uniformity(const std::vector<std::string>& argv, const std::string& command_line) {
   cli::Args args("femto uniformity", argv);
   uniformity::Config c;
@@ -108,23 +81,23 @@ int cmd_uniformity(const std::vector<std::string>& argv, const std::string& comm
       else
         args.fail("expected mfp, time_uniform, line_to_point, angular, equiangular or all", v);
     } else if (a == "--sigma-t" || a == "--sigma_t") {
-      c.sigma_t = number(args, 0, 1e6, true, "in (0, 1e6] (1/mm)");
+      c.sigma_t = args.number_in(0, 1e6, true, false, "in (0, 1e6] (1/mm)");
     } else if (a == "--eta") {
-      c.eta = number(args, 1, 100, false, "in [1, 100]");
+      c.eta = args.number_in(1, 100, false, false, "in [1, 100]");
     } else if (a == "--t-start") {
-      c.t_start_ps = number(args, 0, 1e9, false, "in [0, 1e9] ps");
+      c.t_start_ps = args.number_in(0, 1e9, false, false, "in [0, 1e9] ps");
     } else if (a == "--t-end") {
-      t_end_given = number(args, 0, 1e9, true, "in (0, 1e9] ps");
+      t_end_given = args.number_in(0, 1e9, true, false, "in (0, 1e9] ps");
     } else if (a == "--sensor") {
-      c.sensor = vec3(args);
+      c.sensor = args.xyz_value();
     } else if (a == "--light") {
-      c.light = vec3(args);
+      c.light = args.xyz_value();
     } else if (a == "--dir") {
-      c.dir = vec3(args, true);
+      c.dir = args.xyz_value(true);
     } else if (a == "--segment") {
-      c.segment_mm = number(args, 0, 1e9, false, "in [0, 1e9] mm");
+      c.segment_mm = args.number_in(0, 1e9, false, false, "in [0, 1e9] mm");
     } else if (a == "--lambda") {
-      c.lambda = number(args, 0, 1e9, true, "in (0, 1e9] per mm of optical path length");
+      c.lambda = args.number_in(0, 1e9, true, false, "in (0, 1e9] per mm of optical path length");
     } else if (a == "--mfp-time") {
       const std::string v = args.value();
       if (v == "connection")
@@ -140,7 +113,7 @@ int cmd_uniformity(const std::vector<std::string>& argv, const std::string& comm
     } else if (a == "--bins") {
       c.bins = static_cast<int>(args.int_value(2, 10000));
     } else if (a == "--alpha") {
-      c.alpha = number(args, 0, 1, true, "in (0, 1)", true);
+      c.alpha = args.number_in(0, 1, true, true, "in (0, 1)");
     } else if (a == "--out") {
       out_dir = args.value();
       if (out_dir.empty()) args.fail("expects a folder", "");
