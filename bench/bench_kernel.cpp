@@ -34,6 +34,7 @@
 #include "core/rng.h"
 #include "core/scene_loader.h"
 #include "samplers/stats.h"
+#include "tests/single_scatter.h"
 
 using namespace femto;
 
@@ -76,70 +77,27 @@ uint64_t mix(uint64_t x) {  // splitmix64 finaliser
 // [s(t0), s(t1)], with s(t) = (tau^2 - h^2) / (2 tau), tau = c t / eta >= h.
 // The time response jumps from 0 to its maximum at t = eta h / c (a step), falls like the 1/r^2
 // peak over ~eta h / c, then decays slowly (exp(-sigma_t c t / eta) / t^2) over the window.
-struct Pixel {
-  double sigma_a = 0.01, sigma_s = 0.04, g = 0.4, eta = 1.33, h = 4.0, I = 1000.0;
-  TimeAxis axis;
-
+struct Pixel : femto::test::SingleScatterSetup {
   Pixel() {
+    sigma_a = 0.01;
+    sigma_s = 0.04;
+    g = 0.4;
+    eta = 1.33;
+    h = 4.0;
+    I = 1000.0;
     axis.t_start_ps = 8.0;  // onset at eta h / c = 17.7 ps
     axis.bin_width_ps = 1.0;
     axis.bins = 256;
   }
-  double onset_ps() const { return eta * h / kSpeedOfLight; }
-  double radiance_per_mm(double s) const {
-    const double st = sigma_a + sigma_s;
-    const double r = std::sqrt(s * s + h * h);
-    const double cos_t = -s / r;
-    const double denom = 1.0 + g * g - 2.0 * g * cos_t;
-    const double phase = (1.0 - g * g) / (4.0 * kPi * denom * std::sqrt(denom));
-    return sigma_s * std::exp(-st * s) * phase * I * std::exp(-st * r) / (r * r);
-  }
-  double s_of_time(double t_ps) const {
-    const double tau = std::max(t_ps * kSpeedOfLight / eta, h);
-    return (tau * tau - h * h) / (2.0 * tau);
-  }
-  /// Integral of L over [s0, s1], split into pieces of at most 4 mm so the adaptive rule sees
-  /// the peak; relative tolerance ~1e-12.
-  double integral(double s0, double s1) const {
-    double sum = 0.0;
-    const int pieces = std::max(1, static_cast<int>(std::ceil((s1 - s0) / 4.0)));
-    const double scale = radiance_per_mm(s0) * (s1 - s0) + 1e-300;
-    for (int k = 0; k < pieces; ++k) {
-      const double a = s0 + (s1 - s0) * k / pieces, b = s0 + (s1 - s0) * (k + 1) / pieces;
-      sum += stats::adaptive_simpson([this](double s) { return radiance_per_mm(s); }, a, b, 1e-13 * scale);
-    }
-    return sum;
-  }
   std::vector<double> exact_bins() const {
     std::vector<double> v;
-    for (int i = 0; i < axis.bins; ++i) {
-      const double s0 = s_of_time(axis.bin_start_ps(i)), s1 = s_of_time(axis.bin_start_ps(i + 1));
-      v.push_back(s1 > s0 ? integral(s0, s1) : 0.0);
-    }
+    for (int i = 0; i < axis.bins; ++i) v.push_back(bin(i));
     return v;
   }
   /// Everything the pixel receives, in and out of the window (the tail to 60 mean free paths).
-  double exact_total() const { return integral(0.0, 60.0 / (sigma_a + sigma_s)); }
-
+  double exact_total() const { return integral(0.0, 60.0 / sigma_t()); }
   SceneDesc scene(const ReconstructionDesc& rec) const {
-    SceneDesc d;
-    d.source = "bench: single scattering";
-    d.camera.type = CameraDesc::Type::Orthographic;
-    d.camera.position = {0, 0, 0};
-    d.camera.look_at = {0, 0, 1};
-    d.camera.up = {0, 1, 0};
-    d.camera.ortho_width = 1e-4;
-    d.camera.width = d.camera.height = 1;
-    d.time = axis;
-    MediumDesc m;
-    m.name = "m";
-    m.medium = HomogeneousMedium{sigma_a, sigma_s, g, eta};
-    d.media.push_back(m);
-    d.global_medium = 0;
-    LightDesc l;
-    l.position = {0, h, 0};
-    l.intensity = RGB(I);
-    d.lights.push_back(l);
+    SceneDesc d = SingleScatterSetup::scene();
     d.reconstruction = rec;
     return d;
   }

@@ -26,6 +26,7 @@
 #include "core/scene_desc.h"
 #include "media/phase_hg.h"
 #include "samplers/stats.h"
+#include "tests/single_scatter.h"
 
 using namespace femto;
 
@@ -36,58 +37,22 @@ namespace {
 // delta pulse at t = 0. A vertex at s reaches the sensor at camera time
 //   t(s) = eta (s + r(s)) / c,  r = sqrt(s^2 + h^2),
 // and contributes sigma_s exp(-sigma_t s) f(cos) I exp(-sigma_t r) / r^2 per unit distance.
-struct Setup {
-  double sigma_a = 0.002, sigma_s = 0.008, g = 0.3, eta = 1.0, h = 20.0, I = 1000.0;
-  TimeAxis axis;
-
+struct Setup : femto::test::SingleScatterSetup {
   Setup() {
+    sigma_a = 0.002;
+    sigma_s = 0.008;
+    g = 0.3;
+    eta = 1.0;
+    h = 20.0;
+    I = 1000.0;
     axis.t_start_ps = 0.0;
     axis.bin_width_ps = 80.0;
     axis.bins = 75;  // 6 ns: 1800 mm of light travel, 18 mean free paths (sigma_t = 0.01/mm)
   }
-  double sigma_t() const { return sigma_a + sigma_s; }
   double mean_free_time_ps() const { return eta / (sigma_t() * kSpeedOfLight); }
-
-  double density(double s) const {
-    const double st = sigma_t();
-    const double r = std::sqrt(s * s + h * h);
-    const double cos_t = -s / r;  // light travels (x - L) / r, then towards the sensor along -z
-    return sigma_s * std::exp(-st * s) * hg_eval(cos_t, g) * I * std::exp(-st * r) / (r * r);
-  }
-  /// Inverse of t(s): s + sqrt(s^2 + h^2) = L  <=>  s = (L^2 - h^2) / (2 L), L >= h.
-  double s_of_time(double t_ps) const {
-    const double L = std::max(t_ps * kSpeedOfLight / eta, h);
-    return (L * L - h * h) / (2.0 * L);
-  }
-  /// Exact bin-integrated radiance of bin i, to a relative tolerance (the late bins are many
-  /// orders of magnitude below the early ones, so an absolute one would not do).
-  double bin(int i) const {
-    const double s0 = s_of_time(axis.bin_start_ps(i)), s1 = s_of_time(axis.bin_start_ps(i + 1));
-    if (!(s1 > s0)) return 0.0;
-    const double scale = (s1 - s0) * std::max({density(s0), density(0.5 * (s0 + s1)), density(s1)});
-    return stats::adaptive_simpson([&](double s) { return density(s); }, s0, s1, 1e-11 * scale);
-  }
-
   SceneDesc scene(ConnectionSampling connection) const {
-    SceneDesc d;
-    d.source = "bench: single scattering";
-    d.camera.type = CameraDesc::Type::Orthographic;
-    d.camera.position = {0, 0, 0};
-    d.camera.look_at = {0, 0, 1};
-    d.camera.up = {0, 1, 0};
-    d.camera.ortho_width = 1e-4;
-    d.camera.width = d.camera.height = 1;
-    d.time = axis;
-    MediumDesc m;
-    m.name = "m";
-    m.medium = HomogeneousMedium{sigma_a, sigma_s, g, eta};
-    m.connection = connection;
-    d.media.push_back(m);
-    d.global_medium = 0;
-    LightDesc l;
-    l.position = {0, h, 0};
-    l.intensity = RGB(I);
-    d.lights.push_back(l);
+    SceneDesc d = SingleScatterSetup::scene();
+    d.media[0].connection = connection;
     return d;
   }
 };
