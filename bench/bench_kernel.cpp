@@ -482,9 +482,13 @@ int convergence(const Options& opt) {
 
     std::printf("\n  fitted log-log slope of the RMSE vs n (least squares over n >= %.0f; over all n in brackets)\n",
                 rg.n_split);
-    for (size_t k = 0; k < ms.size(); ++k)
-      std::printf("    %-22s %+.3f  [%+.3f]   %s%s\n", ms[k].label, rg.fits[k].slope, rg.fits_all[k].slope,
-                  main_region ? "theory " : "", main_region ? ms[k].theory : "");
+    for (size_t k = 0; k < ms.size(); ++k) {
+      char a[16] = "   n/a", b[16] = "   n/a";
+      if (std::isfinite(rg.fits[k].slope)) std::snprintf(a, sizeof a, "%+.3f", rg.fits[k].slope);
+      if (std::isfinite(rg.fits_all[k].slope)) std::snprintf(b, sizeof b, "%+.3f", rg.fits_all[k].slope);
+      std::printf("    %-22s %s  [%s]   %s%s\n", ms[k].label, a, b, main_region ? "theory " : "",
+                  main_region ? ms[k].theory : "");
+    }
     if (main_region) {
       std::printf("    (the -2/5 of seed 000 Supp. B assumes a smooth signal. This one jumps at the onset: the\n"
                   "    kernel moves O(J w) into or out of each of the ~T/w bins next to the jump J, so the\n"
@@ -494,8 +498,9 @@ int convergence(const Options& opt) {
       int cnt = 0;
       for (size_t j = 0; j < ns.size(); ++j)
         if (cells[0][j].valid) lr += std::log(rg.rmse[j] / rg.rmse[ns.size() + j]), ++cnt;
-      std::printf("    no path reuse / histogram RMSE, geometric mean over n >= %d: %.2f (theory sqrt(%d) = %.0f)\n",
-                  bins, std::exp(lr / cnt), bins, std::sqrt(static_cast<double>(bins)));
+      if (cnt > 0)
+        std::printf("    no path reuse / histogram RMSE, geometric mean over n >= %d: %.2f (theory sqrt(%d) = %.0f)\n",
+                    bins, std::exp(lr / cnt), bins, std::sqrt(static_cast<double>(bins)));
     }
 
     // Equal-error sample ratio: histogram samples needed to reach the kernel's RMSE at n, from the
@@ -582,10 +587,12 @@ int convergence(const Options& opt) {
       if (std::abs(z) > worst) worst = std::abs(z), worst_bin = i;
       off += std::abs(z) > 3.5;
     }
+    char expect[48] = "no finite expectation";
+    if (opt.runs > 3) std::snprintf(expect, sizeof expect, "about %.2f expected", (opt.runs - 1.0) / (opt.runs - 3.0));
     std::printf("\n  check of the exact answer: histogram at n = %d, mean over runs vs quadrature per bin:\n"
-                "  mean z^2 %.2f over %d bins with signal (about %.2f expected for %d runs), %d bins with |z| > 3.5,\n"
+                "  mean z^2 %.2f over %d bins with signal (%s for %d runs), %d bins with |z| > 3.5,\n"
                 "  largest |z| %.2f (bin at %.0f ps); bins before the onset hold %s\n",
-                ns.back(), z2 / nonzero, nonzero, (opt.runs - 1.0) / (opt.runs - 3.0), opt.runs, off, worst,
+                ns.back(), z2 / nonzero, nonzero, expect, opt.runs, off, worst,
                 px.axis.bin_start_ps(std::max(0, worst_bin)), early > 0 ? "energy (wrong)" : "nothing, as they should");
   }
 
@@ -655,14 +662,15 @@ int convergence(const Options& opt) {
     for (double t : ts) std::printf(" %8.2f", m.acc.bandwidth_at(t));
     std::printf("\n");
   }
-  std::printf("\n  CPU time per sample on this pixel (n >= 4096, all runs; 1 ps bins, so a kernel deposit\n"
-              "  covers 2 T / 1 ps bins):");
+  const int n_cpu = std::min(4096, ns.back());
+  std::printf("\n  CPU time per sample on this pixel (n >= %d, all runs; 1 ps bins, so a kernel deposit\n"
+              "  covers 2 T / 1 ps bins):", n_cpu);
   for (size_t k = 0; k < ms.size(); ++k) {
     double secs = 0, samples = 0;
     for (size_t j = 0; j < ns.size(); ++j)
-      if (cells[k][j].valid && ns[j] >= 4096)
+      if (cells[k][j].valid && ns[j] >= n_cpu)
         for (double v : cells[k][j].cpu) secs += v, samples += ns[j];
-    std::printf("%s %s %.3g us", k == 0 ? "" : ",", ms[k].name, 1e6 * secs / samples);
+    if (samples > 0) std::printf("%s %s %.3g us", k == 0 ? "" : ",", ms[k].name, 1e6 * secs / samples);
   }
   std::printf("\n  time: %.1f s for all renders (%d threads)\n", elapsed, opt.threads);
 
