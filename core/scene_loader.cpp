@@ -672,6 +672,8 @@ class Loader {
                      : v == "equiangular"   ? ConnectionSampling::Equiangular
                      : v == "line_to_point" ? ConnectionSampling::LineToPoint
                                             : ConnectionSampling::Mis;
+    } else {
+      m.connection = ConnectionSampling::Mis;  // the default for scene files (docs/scene-format.md)
     }
     if (const Json* d = find(o, "direction_sampling"))
       m.direction = choice(*d, at(mp, "direction_sampling"), {"phase", "angular"}) == "phase"

@@ -634,7 +634,7 @@ TEST_CASE("scene loader: vdb media and distance-sampling keys", "[scene_loader]"
   CHECK(md.vdb.transform.scale.y == 1);
   CHECK(md.time_uniform_rate == 0.0);  // automatic
   CHECK(md.mis_heuristic == femto::MisHeuristic::Balance);
-  CHECK(md.connection == femto::ConnectionSampling::Collision);
+  CHECK(md.connection == femto::ConnectionSampling::Mis);  // the scene-file default
   CHECK(md.direction == femto::DirectionSampling::Phase);
 
   // A constant albedo; a dielectric around a VDB medium of the same eta.
