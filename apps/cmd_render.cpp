@@ -67,6 +67,13 @@ const char* kRenderHelp =
 
 nlohmann::json rgb_json(const RGB& c) { return nlohmann::json::array({c.r, c.g, c.b}); }
 
+/// The scene as parsed (scene files may hold // comments), or its text if it cannot be parsed
+/// again: render.json must stay valid JSON.
+nlohmann::json scene_json(const std::string& text) {
+  nlohmann::json j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false, /*ignore_comments=*/true);
+  return j.is_discarded() ? nlohmann::json(text) : j;
+}
+
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the scene file");
@@ -249,7 +256,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   info["command"] = command_line;
   info["date_utc"] = cli::utc_now();
   info["scene"] = {{"source", scene.desc().source},
-                   {"json", nlohmann::json::parse(scene_text, nullptr, false)}};
+                   {"json", scene_json(scene_text)}};
   info["settings"] = {{"spp", opt.spp},
                       {"seed", opt.seed},
                       {"threads", result.threads},

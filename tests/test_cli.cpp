@@ -276,6 +276,24 @@ TEST_CASE("cli: --frames multipart and --frames none", "[cli]") {
   }
 }
 
+// Catches: render.json turning invalid JSON (a "<discarded>" value) when the scene file holds
+// // comments, which the scene loader accepts.
+TEST_CASE("cli: render.json stays valid JSON for scene files with comments", "[cli]") {
+  CliTempDir tmp;
+  std::string text = small_scene().dump(2);
+  text.insert(text.find('{') + 1, "\n  // a comment the loader skips\n");
+  write_text(tmp.dir / "commented.json", text);
+  const fs::path out = tmp.dir / "out";
+  const RunResult r = run_femto({"render", "commented.json", "--spp", "1", "--frames", "none", "--no-previews",
+                                 "--out", out.string(), "--quiet"},
+                                tmp.dir, tmp.dir / "logs");
+  INFO(r.command << "\nstderr: " << r.err);
+  REQUIRE(r.code == 0);
+  const json info = json::parse(read_text(out / "render.json"), nullptr, false);
+  REQUIRE_FALSE(info.is_discarded());
+  CHECK(info["scene"]["json"]["time"]["bins"] == small_scene()["time"]["bins"]);
+}
+
 // Catches: the kernel film's scene keys or flags being ignored, render.json not recording them,
 // kernel_bandwidth.exr missing or holding nonsense, and the kernel film losing energy against the
 // histogram film rendered from the same paths.
