@@ -17,11 +17,11 @@ struct PixelAccumulator {
   // Kernel film (core/reconstruction.h): bandwidth of an arrival at t = scale * base(t), base =
   // `fixed_ps` when > 0, else the distance to the k-th nearest first-pass arrival (at most cap).
   bool kernel = false;
-  double scale = 1.0;          ///< r_j / r_P (adaptive) or r_j (fixed) for the current sample
+  double scale = 1.0;  ///< r_j / r_P (adaptive) or r_j (fixed) for the current sample
   double fixed_ps = 0.0;
   int knn = 40;
-  double cap_ps = 0.0;         ///< widest useful kernel (the window length)
-  double fallback_ps = 0.0;    ///< base when the first pass had no arrival
+  double cap_ps = 0.0;       ///< widest useful kernel (the window length)
+  double fallback_ps = 0.0;  ///< base when the first pass had no arrival
   /// First pass of a k-NN kernel film: deposits wait here until the bandwidth is known.
   struct Held {
     double t_ps, sigma_ps;
@@ -29,8 +29,8 @@ struct PixelAccumulator {
     int sample;
   };
   bool hold = false;
-  int sample = 0;            ///< index of the sample being traced (recorded in Held)
-  std::vector<Held> held;    ///< capacity kept between pixels: no allocation once warm
+  int sample = 0;             ///< index of the sample being traced (recorded in Held)
+  std::vector<Held> held;     ///< capacity kept between pixels: no allocation once warm
   std::vector<double> times;  ///< first-pass arrival times, sorted
 
   void reset(int n_bins) {
@@ -57,7 +57,8 @@ struct PixelAccumulator {
     }
     add_now(filter, t_ps, sigma_ps, value, bandwidth_at(t_ps));
   }
-  void add_now(const TemporalFilter& filter, double t_ps, double sigma_ps, const RGB& value, double T) {
+  void add_now(const TemporalFilter& filter, double t_ps, double sigma_ps, const RGB& value,
+               double T) {
     const DepositSplit split = filter.deposit(t_ps, sigma_ps, value, bins.data(), T);
     if (split.before > 0) before += value * split.before;
     if (split.after > 0) after += value * split.after;

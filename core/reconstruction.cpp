@@ -9,7 +9,8 @@ double kth_nearest_distance(const std::vector<double>& sorted_times, double t, i
   if (n == 0) return -1.0;
   const size_t steps = std::min(n, static_cast<size_t>(std::max(k, 1)));
   // Merge outwards from t's insertion point, taking the nearer neighbour each step.
-  size_t hi = static_cast<size_t>(std::lower_bound(sorted_times.begin(), sorted_times.end(), t) - sorted_times.begin());
+  size_t hi = static_cast<size_t>(std::lower_bound(sorted_times.begin(), sorted_times.end(), t) -
+                                  sorted_times.begin());
   size_t lo = hi;  // candidates: sorted_times[lo - 1] on the left, sorted_times[hi] on the right
   double d = 0.0;
   for (size_t i = 0; i < steps; ++i) {

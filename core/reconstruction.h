@@ -1,8 +1,8 @@
 #pragma once
 // How the film turns time-stamped path contributions into time bins: the histogram, or the
 // progressive kernel density estimate of seed 000 Sec. 4 / Supp. B. Sample j of a pixel
-// (j = 1, 2, ...) deposits with a bandwidth proportional to r_j, r_{j+1} = r_j (j + alpha) / (j + 1);
-// the pixel value is the plain average over its samples, consistent because r_j -> 0. The
+// (j = 1, 2, ...) deposits with a bandwidth proportional to r_j, r_{j+1} = r_j (j + alpha) / (j +
+// 1); the pixel value is the plain average over its samples, consistent because r_j -> 0. The
 // bandwidth of an arrival at time t is either fixed (T_1 r_j) or adaptive: the distance from t
 // to the k-th nearest arrival of the pixel's first pass, times r_j / r_P (P = first-pass size), so
 // a sharp peak keeps a narrow kernel while a diffuse tail gets a wide one.
@@ -17,10 +17,12 @@ namespace femto {
 struct ReconstructionDesc {
   TemporalFilter::Kind type = TemporalFilter::Kind::Histogram;
   TemporalKernel kernel = TemporalKernel::Perlin;
-  double alpha = 0.8;        ///< bandwidth shrinking exponent in (0, 1]; 1 keeps T fixed (biased)
-  int knn = 40;              ///< k of the k-nearest-arrival bandwidth
-  int first_pass_spp = 160;  ///< samples per pixel whose arrival times set the bandwidth (several k)
-  double bandwidth_ps = 0.0; ///< user-given T_1 > 0 for every arrival; 0 = k-nearest-arrival bandwidth
+  double alpha = 0.8;  ///< bandwidth shrinking exponent in (0, 1]; 1 keeps T fixed (biased)
+  int knn = 40;        ///< k of the k-nearest-arrival bandwidth
+  int first_pass_spp =
+      160;  ///< samples per pixel whose arrival times set the bandwidth (several k)
+  double bandwidth_ps =
+      0.0;  ///< user-given T_1 > 0 for every arrival; 0 = k-nearest-arrival bandwidth
 };
 
 /// Ratio T_j / T_1 = prod_{i=1}^{j-1} (i + alpha) / (i + 1), updated one sample at a time.

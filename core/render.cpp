@@ -28,13 +28,15 @@ double typical_bandwidth(const PixelAccumulator& acc, const TimeAxis& axis) {
 }
 }  // namespace
 
-void render_pixel(const Scene& scene, const VolPathIntegrator& integrator, const TemporalFilter& filter,
-                  const RenderOptions& opt, int x, int y, PixelAccumulator& acc, PathStats& st) {
+void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
+                  const TemporalFilter& filter, const RenderOptions& opt, int x, int y,
+                  PixelAccumulator& acc, PathStats& st) {
   const Camera& camera = scene.camera();
   const TimeAxis& axis = filter.axis();
   const ReconstructionDesc& rec = scene.desc().reconstruction;
   acc.reset(axis.bins);
-  const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(camera.width()) + static_cast<uint64_t>(x);
+  const uint64_t pixel =
+      static_cast<uint64_t>(y) * static_cast<uint64_t>(camera.width()) + static_cast<uint64_t>(x);
   auto trace_sample = [&](int s) {
     Rng rng = Rng::for_sample(opt.seed, pixel, static_cast<uint64_t>(s));
     const double fx = x + rng.uniform(), fy = y + rng.uniform();
@@ -53,7 +55,8 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator, const
   // First pass: its arrival times set the bandwidth, anchored (r_j / r_P) so that its last
   // sample uses the k-NN distance itself.
   const int first_pass = rec.bandwidth_ps <= 0.0 ? std::min(opt.spp, rec.first_pass_spp) : 0;
-  const double norm = first_pass > 0 ? 1.0 / BandwidthSchedule::ratio_at(rec.alpha, first_pass) : 1.0;
+  const double norm =
+      first_pass > 0 ? 1.0 / BandwidthSchedule::ratio_at(rec.alpha, first_pass) : 1.0;
   BandwidthSchedule schedule(rec.alpha);
   if (first_pass > 0) {
     acc.hold = true;
@@ -73,7 +76,8 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator, const
     trace_sample(s);
     schedule.advance();
   }
-  acc.scale = norm * BandwidthSchedule::ratio_at(rec.alpha, opt.spp);  // the last sample's, for typical_bandwidth
+  acc.scale = norm * BandwidthSchedule::ratio_at(
+                         rec.alpha, opt.spp);  // the last sample's, for typical_bandwidth
 }
 
 RenderResult render(const Scene& scene, const RenderOptions& opt) {
@@ -85,40 +89,45 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
   const ReconstructionDesc& rec = scene.desc().reconstruction;
   const bool kernel = rec.type == TemporalFilter::Kind::Kernel;
   const TemporalFilter filter(axis, rec.type, rec.kernel);
-  if (kernel) result.final_bandwidth_ps.assign(static_cast<size_t>(W) * static_cast<size_t>(H), 0.0f);
+  if (kernel)
+    result.final_bandwidth_ps.assign(static_cast<size_t>(W) * static_cast<size_t>(H), 0.0f);
   const VolPathIntegrator integrator(scene, filter, opt.max_depth);
 
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
   result.threads = threads;
-  Progress progress(static_cast<uint64_t>(W) * static_cast<uint64_t>(H) * static_cast<uint64_t>(opt.spp),
-                    "render", opt.quiet);
+  Progress progress(
+      static_cast<uint64_t>(W) * static_cast<uint64_t>(H) * static_cast<uint64_t>(opt.spp),
+      "render", opt.quiet);
   tbb::enumerable_thread_specific<PixelAccumulator> accumulators;
   tbb::enumerable_thread_specific<PathStats> stats;
   tbb::task_arena arena(threads);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
-      PixelAccumulator& acc = accumulators.local();
-      PathStats& st = stats.local();
-      for (int tile = r.begin(); tile != r.end(); ++tile) {
-        const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-        const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
-        for (int y = y0; y < y1; ++y) {
-          for (int x = x0; x < x1; ++x) {
-            render_pixel(scene, integrator, filter, opt, x, y, acc, st);
-            if (kernel)
-              result.final_bandwidth_ps[static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x)] =
-                  static_cast<float>(typical_bandwidth(acc, axis));
-            result.film.set_pixel(x, y, acc.bins.data(), acc.before, acc.after, opt.spp);
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
+          PixelAccumulator& acc = accumulators.local();
+          PathStats& st = stats.local();
+          for (int tile = r.begin(); tile != r.end(); ++tile) {
+            const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+            const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
+            for (int y = y0; y < y1; ++y) {
+              for (int x = x0; x < x1; ++x) {
+                render_pixel(scene, integrator, filter, opt, x, y, acc, st);
+                if (kernel)
+                  result.final_bandwidth_ps[static_cast<size_t>(y) * static_cast<size_t>(W) +
+                                            static_cast<size_t>(x)] =
+                      static_cast<float>(typical_bandwidth(acc, axis));
+                result.film.set_pixel(x, y, acc.bins.data(), acc.before, acc.after, opt.spp);
+              }
+              progress.add(static_cast<uint64_t>(x1 - x0) * static_cast<uint64_t>(opt.spp));
+            }
           }
-          progress.add(static_cast<uint64_t>(x1 - x0) * static_cast<uint64_t>(opt.spp));
-        }
-      }
-    });
+        });
   });
   progress.finish();
   for (const PathStats& s : stats) result.stats += s;
-  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

@@ -43,12 +43,15 @@ struct SingleScatterSetup {
     for (int k = 0; k < pieces; ++k) {
       const double a = s0 + (s1 - s0) * k / pieces, b = s0 + (s1 - s0) * (k + 1) / pieces;
       const double scale = (b - a) * std::max({density(a), density(0.5 * (a + b)), density(b)});
-      sum += stats::adaptive_simpson([&](double s) { return density(s); }, a, b, 1e-11 * scale + 1e-300);
+      sum += stats::adaptive_simpson([&](double s) { return density(s); }, a, b,
+                                     1e-11 * scale + 1e-300);
     }
     return sum;
   }
   /// Exact bin-integrated radiance of bin i.
-  double bin(int i) const { return integral(s_of_time(axis.bin_start_ps(i)), s_of_time(axis.bin_start_ps(i + 1))); }
+  double bin(int i) const {
+    return integral(s_of_time(axis.bin_start_ps(i)), s_of_time(axis.bin_start_ps(i + 1)));
+  }
   /// The scene: a 1 x 1 orthographic pixel looking down +z (render with max_depth 1).
   SceneDesc scene() const {
     SceneDesc d;

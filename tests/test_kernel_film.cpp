@@ -43,7 +43,8 @@ SceneDesc with_reconstruction(SceneDesc d, TemporalFilter::Kind kind, double ban
 
 // Catches: kernel deposits that gain or lose energy (bins + before + after != 1), also across
 // the window edges and for Gaussian pulses; a kernel shape that differs from kernel_bin_weight;
-// a widened Gaussian whose variance is not the pulse's plus the kernel's; T = 0 unlike the histogram.
+// a widened Gaussian whose variance is not the pulse's plus the kernel's; T = 0 unlike the
+// histogram.
 TEST_CASE("kernel deposits keep their energy bin by bin", "[kernel_film]") {
   TimeAxis axis;
   axis.t_start_ps = 100;
@@ -55,7 +56,8 @@ TEST_CASE("kernel deposits keep their energy bin by bin", "[kernel_film]") {
     const TemporalFilter histogram(axis, TemporalFilter::Kind::Histogram);
     for (int trial = 0; trial < 400; ++trial) {
       const double t = 40 + 220 * rng.uniform();
-      const double T = std::exp(std::log(0.05) + std::log(2000.0) * rng.uniform());  // 0.05 .. 100 ps
+      const double T =
+          std::exp(std::log(0.05) + std::log(2000.0) * rng.uniform());  // 0.05 .. 100 ps
       const double sigma = trial % 3 == 0 ? 0.5 + 4 * rng.uniform() : 0.0;
       std::vector<double> bins(static_cast<size_t>(axis.bins) * 3, 0.0);
       const DepositSplit sp = kernel.deposit(t, sigma, RGB(1.0, 2.0, 3.0), bins.data(), T);
@@ -66,15 +68,19 @@ TEST_CASE("kernel deposits keep their energy bin by bin", "[kernel_film]") {
       if (sigma == 0.0) {
         for (int i = 0; i < axis.bins; ++i)
           CHECK(std::abs(bins[3 * static_cast<size_t>(i)] -
-                         kernel_bin_weight(k, t, T, axis.bin_start_ps(i), axis.bin_start_ps(i + 1))) < 1e-12);
-      } else if (sp.inside > 1.0 - 1e-9 && sigma * sigma + kernel_variance(k) * T * T > 4 * axis.bin_width_ps * axis.bin_width_ps) {
+                         kernel_bin_weight(k, t, T, axis.bin_start_ps(i),
+                                           axis.bin_start_ps(i + 1))) < 1e-12);
+      } else if (sp.inside > 1.0 - 1e-9 && sigma * sigma + kernel_variance(k) * T * T >
+                                               4 * axis.bin_width_ps * axis.bin_width_ps) {
         // Fully inside and wider than 2 bins: the bin-centre variance is sigma^2 + var_k T^2
         // plus the bins' w^2 / 12 (Sheppard's correction, exact to ~1e-8 for such a Gaussian).
         double mean = 0, m2 = 0;
-        for (int i = 0; i < axis.bins; ++i) mean += bins[3 * static_cast<size_t>(i)] * axis.bin_center_ps(i);
+        for (int i = 0; i < axis.bins; ++i)
+          mean += bins[3 * static_cast<size_t>(i)] * axis.bin_center_ps(i);
         for (int i = 0; i < axis.bins; ++i)
           m2 += bins[3 * static_cast<size_t>(i)] * std::pow(axis.bin_center_ps(i) - mean, 2);
-        const double expected = sigma * sigma + kernel_variance(k) * T * T + axis.bin_width_ps * axis.bin_width_ps / 12;
+        const double expected =
+            sigma * sigma + kernel_variance(k) * T * T + axis.bin_width_ps * axis.bin_width_ps / 12;
         CHECK(std::abs(mean - t) < 1e-6);
         CHECK(std::abs(m2 - expected) < 1e-4 * expected);
       }
@@ -93,11 +99,13 @@ TEST_CASE("k-th nearest arrival distance matches brute force", "[kernel_film]") 
   Rng rng(11, 1);
   for (int n : {1, 2, 7, 100}) {
     std::vector<double> times;
-    for (int i = 0; i < n; ++i) times.push_back(std::floor(1000 * rng.uniform()) * 0.5);  // with ties
+    for (int i = 0; i < n; ++i)
+      times.push_back(std::floor(1000 * rng.uniform()) * 0.5);  // with ties
     std::sort(times.begin(), times.end());
     for (int k : {1, 3, 40}) {
       for (int trial = 0; trial < 50; ++trial) {
-        const double t = trial < 5 ? times[static_cast<size_t>(trial) % times.size()] : -100 + 800 * rng.uniform();
+        const double t = trial < 5 ? times[static_cast<size_t>(trial) % times.size()]
+                                   : -100 + 800 * rng.uniform();
         std::vector<double> d;
         for (double x : times) d.push_back(std::abs(x - t));
         std::sort(d.begin(), d.end());
@@ -135,8 +143,8 @@ TEST_CASE("kernel film equals its exact expectation on single scattering", "[ker
     const double s0 = p.s_of_time(b0 - T1), s1 = p.s_of_time(b1 + T1);
     const double expected = s1 > s0 ? stats::adaptive_simpson(integrand, s0, s1, 1e-11) : 0.0;
     const MeanSE m = bin_mean_se(films, i);
-    INFO("bin " << i << ": " << m.mean << " +- " << m.se << ", expected " << expected << ", histogram answer "
-                << p.bin(i));
+    INFO("bin " << i << ": " << m.mean << " +- " << m.se << ", expected " << expected
+                << ", histogram answer " << p.bin(i));
     CHECK(std::abs(m.mean - expected) < 4.0 * m.se + 1e-9 * expected);
     // The test can tell the kernel from the histogram where the smoothing matters.
     if (std::abs(expected - p.bin(i)) > 8.0 * m.se) ++resolved;
@@ -163,8 +171,8 @@ TEST_CASE("progressive kernel bias shrinks as samples grow", "[kernel_film]") {
   };
   const double early = bias2(64, 64), late = bias2(4096, 16);
   INFO("relative squared bias: 64 spp " << early << ", 4096 spp " << late);
-  CHECK(early > 1e-3);           // there is bias to remove at 64 spp
-  CHECK(late < 0.5 * early);     // and it shrinks
+  CHECK(early > 1e-3);        // there is bias to remove at 64 spp
+  CHECK(late < 0.5 * early);  // and it shrinks
 }
 
 // Catches: a kernel film that is no better than the histogram (the reason it exists): with 1 ps
@@ -175,13 +183,16 @@ TEST_CASE("kernel film beats the histogram at equal samples", "[kernel_film]") {
   std::vector<double> exact;
   for (int i = 0; i < p.axis.bins; ++i) exact.push_back(p.bin(i));
   auto mse = [&](TemporalFilter::Kind kind) {
-    const auto films = render_batches(with_reconstruction(p.scene(), kind), 256, 8, /*max_depth=*/1);
+    const auto films =
+        render_batches(with_reconstruction(p.scene(), kind), 256, 8, /*max_depth=*/1);
     double e2 = 0;
     for (const auto& f : films)
-      for (int i = 0; i < p.axis.bins; ++i) e2 += std::pow(f.transient()[3 * i] - exact[static_cast<size_t>(i)], 2);
+      for (int i = 0; i < p.axis.bins; ++i)
+        e2 += std::pow(f.transient()[3 * i] - exact[static_cast<size_t>(i)], 2);
     return e2 / static_cast<double>(films.size());
   };
-  const double kernel = mse(TemporalFilter::Kind::Kernel), histogram = mse(TemporalFilter::Kind::Histogram);
+  const double kernel = mse(TemporalFilter::Kind::Kernel),
+               histogram = mse(TemporalFilter::Kind::Histogram);
   INFO("summed squared error per render: kernel " << kernel << ", histogram " << histogram);
   CHECK(kernel < 0.5 * histogram);
 }

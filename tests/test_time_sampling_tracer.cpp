@@ -2,10 +2,10 @@
 // MIS) and angular direction sampling must leave every time bin unbiased.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "media/volume_data.h"
@@ -30,13 +30,15 @@ struct BinStats {
 /// Per-bin mean and standard error over batches of the sum over all pixels (green channel).
 BinStats bin_stats(const std::vector<TransientFilm>& films) {
   const int T = films[0].bins();
-  const size_t pixels = static_cast<size_t>(films[0].width()) * static_cast<size_t>(films[0].height());
+  const size_t pixels =
+      static_cast<size_t>(films[0].width()) * static_cast<size_t>(films[0].height());
   BinStats out;
   for (int i = 0; i < T; ++i) {
     std::vector<double> v;
     for (const auto& f : films) {
       double s = 0;
-      for (size_t p = 0; p < pixels; ++p) s += f.transient()[(p * static_cast<size_t>(T) + static_cast<size_t>(i)) * 3 + 1];
+      for (size_t p = 0; p < pixels; ++p)
+        s += f.transient()[(p * static_cast<size_t>(T) + static_cast<size_t>(i)) * 3 + 1];
       v.push_back(s);
     }
     const MeanSE m = mean_se(v);
@@ -51,7 +53,8 @@ int check_agreement(const BinStats& a, const BinStats& b, const std::string& wha
   int compared = 0;
   for (size_t i = 0; i < a.mean.size(); ++i) {
     const double se = std::sqrt(a.se[i] * a.se[i] + b.se[i] * b.se[i]);
-    INFO(what << " bin " << i << ": " << a.mean[i] << " +- " << a.se[i] << " vs " << b.mean[i] << " +- " << b.se[i]);
+    INFO(what << " bin " << i << ": " << a.mean[i] << " +- " << a.se[i] << " vs " << b.mean[i]
+              << " +- " << b.se[i]);
     CHECK(std::abs(a.mean[i] - b.mean[i]) <= 4.0 * se + 1e-12 * std::abs(b.mean[i]));
     if (b.mean[i] > 0) ++compared;
   }
@@ -68,7 +71,8 @@ TEST_CASE("segment connections match the single-scattering answer bin by bin", "
   p.axis.t_start_ps = 100;
   p.axis.bin_width_ps = 10;
   p.axis.bins = 40;
-  for (ConnectionSampling c : {ConnectionSampling::Equiangular, ConnectionSampling::LineToPoint, ConnectionSampling::Mis}) {
+  for (ConnectionSampling c : {ConnectionSampling::Equiangular, ConnectionSampling::LineToPoint,
+                               ConnectionSampling::Mis}) {
     SceneDesc d = p.scene();
     d.media[0].connection = c;
     const auto films = render_batches(d, 2000, 16, /*max_depth=*/1);
@@ -76,7 +80,8 @@ TEST_CASE("segment connections match the single-scattering answer bin by bin", "
     for (int i = 0; i < p.axis.bins; ++i) {
       const MeanSE m = bin_mean_se(films, i);
       const double expected = p.bin(i);
-      INFO(name_of(c) << " bin " << i << ": " << m.mean << " +- " << m.se << " expected " << expected);
+      INFO(name_of(c) << " bin " << i << ": " << m.mean << " +- " << m.se << " expected "
+                      << expected);
       CHECK(std::abs(m.mean - expected) <= 4.0 * m.se + 1e-9 * expected);
       if (expected > 0) {
         CHECK(m.se < 0.1 * expected);  // enough resolving power to see a missing term
@@ -91,7 +96,8 @@ TEST_CASE("segment connections match the single-scattering answer bin by bin", "
 // surfaces, a spot light beside an area light (MIS with the phase/angular mixture), the
 // time-uniform + MIS distance sampler (shared r_aux), unwarped camera segments, and a
 // heterogeneous voxel medium with varying index. Reference: collision NEE + phase sampling.
-TEST_CASE("time-targeted sampling agrees with the reference estimator with multiple scattering", "[time-sampling]") {
+TEST_CASE("time-targeted sampling agrees with the reference estimator with multiple scattering",
+          "[time-sampling]") {
   TempDir tmp("femto_time_sampling");
   // A heterogeneous voxel medium with a varying index of refraction.
   const int n = 16;
@@ -134,7 +140,8 @@ TEST_CASE("time-targeted sampling agrees with the reference estimator with multi
     }
     d.global_medium = 0;
     d.shapes.push_back(quad({-25, -25, -15}, {50, 0, 0}, {0, 50, 0}, diffuse(0.7)));
-    ShapeDesc lamp = quad({-20, 14, 20}, {0, 0, -40}, {40, 0, 0}, MaterialDesc{});  // large: MIS matters
+    ShapeDesc lamp =
+        quad({-20, 14, 20}, {0, 0, -40}, {40, 0, 0}, MaterialDesc{});  // large: MIS matters
     lamp.emissive = true;
     lamp.emission = RGB(1.0);
     d.shapes.push_back(lamp);  // an area light facing down

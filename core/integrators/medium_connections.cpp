@@ -24,8 +24,8 @@ void connection_window(const TimeAxis& axis, const Light& L, double t, double& t
 }
 }  // namespace
 
-VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& med, const Vec3& x, double t,
-                                                                 double u) const {
+VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& med, const Vec3& x,
+                                                                 double t, double u) const {
   DirectionMix mix;
   mix.u = u;
   mix.t = t;
@@ -35,7 +35,8 @@ VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& m
   if (med.strategy.kind == DistanceSampling::TimeUniform) {
     mix.r_aux = e / (med.strategy.lambda * mix.eta);
   } else {
-    const double sigma_t = med.type == Medium::Type::Grid ? med.grid->sigma_t_at(x) : med.homogeneous.sigma_t();
+    const double sigma_t =
+        med.type == Medium::Type::Grid ? med.grid->sigma_t_at(x) : med.homogeneous.sigma_t();
     mix.r_aux = sigma_t > 0 ? e / sigma_t : std::numeric_limits<double>::infinity();
   }
   if (!std::isfinite(mix.r_aux)) return mix;
@@ -69,14 +70,14 @@ double VolPathIntegrator::angular_pdf(const DirectionMix& mix, const Vec3& x, co
   return pdf;
 }
 
-double VolPathIntegrator::direction_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g,
-                                        const Vec3& w) const {
+double VolPathIntegrator::direction_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& d,
+                                        double g, const Vec3& w) const {
   const double phase = hg_eval(dot(d, w), g);
   return mix.active ? 0.5 * phase + 0.5 * angular_pdf(mix, x, w) : phase;
 }
 
-double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g,
-                                           Rng& rng, Vec3& w, double& pdf) const {
+double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& x, const Vec3& d,
+                                           double g, Rng& rng, Vec3& w, double& pdf) const {
   if (!mix.active) {
     const PhaseSample ps = hg_sample(d, g, rng.uniform(), rng.uniform());
     w = ps.dir;
@@ -113,9 +114,9 @@ double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& 
   return pdf > 0 ? hg_eval(dot(d, w), g) / pdf : 0.0;
 }
 
-void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ray, double s_surf, const RGB& beta,
-                                         double t, double t_factor, Rng& rng, PixelAccumulator& acc,
-                                         PathStats& stats) const {
+void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ray, double s_surf,
+                                         const RGB& beta, double t, double t_factor, Rng& rng,
+                                         PixelAccumulator& acc, PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
@@ -139,7 +140,8 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
   const LineToPointSampler lp(ray.o, ray.d, p, eta0);
   double t_a, t_b;
   connection_window(filter_.axis(), L, t, t_a, t_b);
-  // Unwarped camera segment: the film time leaves out s, so cover every s whose connection can land.
+  // Unwarped camera segment: the film time leaves out s, so cover every s whose connection can
+  // land.
   if (!(t_factor > 0)) t_b += eta0 * s_end / kSpeedOfLight;
   const LineToPointSampler::Window win = lp.window(t_a, t_b, 0.0, s_end);
   const bool eq_ok = use_eq && eq.valid(), lp_ok = use_lp && win.valid;
@@ -151,8 +153,9 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
     const Vec3 y = ray.at(s);
     double tau, opl;
     segment_integrals(m, ray, s, tau, opl);
-    const double sigma_s = med.type == Medium::Type::Grid ? med.grid->sigma_t_at(y) * med.grid->albedo_at(y)
-                                                          : med.homogeneous.sigma_s;
+    const double sigma_s = med.type == Medium::Type::Grid
+                               ? med.grid->sigma_t_at(y) * med.grid->albedo_at(y)
+                               : med.homogeneous.sigma_s;
     if (!(sigma_s > 0)) return;
     LightSample ls;
     if (!lights.sample(li, y, u1, u2, ls)) return;
@@ -160,7 +163,8 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
     double Tr, dt;
     if (!(f > 0) || !connect(y, m, ls.wi, ls.dist, Tr, dt, stats)) return;
     const double weight = sigma_s * std::exp(-tau) * f * Tr / (p_sum * pmf * ls.pdf);
-    deposit(t + opl * t_factor + dt + L.pulse.offset_ps, L.pulse.sigma_ps(), beta * ls.Li * weight, acc, stats);
+    deposit(t + opl * t_factor + dt + L.pulse.offset_ps, L.pulse.sigma_ps(), beta * ls.Li * weight,
+            acc, stats);
   };
   if (eq_ok) contribute(eq.sample(u_e));
   if (lp_ok) contribute(lp.sample(win, u_l));
