@@ -134,15 +134,20 @@ std::vector<Method> methods() {
   };
 }
 
-// One render of the pixel (1 thread; the caller runs renders in parallel).
-std::vector<double> render_pixel(const Scene& scene, int spp, uint64_t seed, double& total) {
+// Single scattering, one thread (the caller runs renders in parallel).
+RenderOptions pixel_options(int spp, uint64_t seed) {
   RenderOptions o;
   o.spp = spp;
   o.seed = seed;
   o.threads = 1;
   o.max_depth = 1;
   o.quiet = true;
-  const RenderResult r = render(scene, o);
+  return o;
+}
+
+// One render of the pixel.
+std::vector<double> render_one(const Scene& scene, int spp, uint64_t seed, double& total) {
+  const RenderResult r = render(scene, pixel_options(spp, seed));
   const TransientFilm& f = r.film;
   std::vector<double> v(static_cast<size_t>(f.bins()));
   for (int i = 0; i < f.bins(); ++i) v[static_cast<size_t>(i)] = f.transient()[3 * i];
@@ -161,13 +166,9 @@ MirrorPixel mirror_pixel(const Scene& scene, int spp, uint64_t seed) {
   const TimeAxis axis = scene.desc().time;
   const TemporalFilter filter(axis, rec.type, rec.kernel);
   const VolPathIntegrator integrator(scene, filter, 1);
-  RenderOptions o;
-  o.spp = spp;
-  o.seed = seed;
-  o.max_depth = 1;
   PathStats st;
   MirrorPixel m;
-  render_pixel(scene, integrator, filter, o, 0, 0, m.acc, st);
+  render_pixel(scene, integrator, filter, pixel_options(spp, seed), 0, 0, m.acc, st);
   double sum = m.acc.before.r + m.acc.after.r;
   for (int i = 0; i < axis.bins; ++i) sum += m.acc.bins[3 * static_cast<size_t>(i)];
   m.total = sum / spp;
@@ -175,13 +176,7 @@ MirrorPixel mirror_pixel(const Scene& scene, int spp, uint64_t seed) {
 }
 
 bool same_as_film(const MirrorPixel& m, const Scene& scene, int spp, uint64_t seed) {
-  RenderOptions o;
-  o.spp = spp;
-  o.seed = seed;
-  o.threads = 1;
-  o.max_depth = 1;
-  o.quiet = true;
-  const RenderResult r = render(scene, o);
+  const RenderResult r = render(scene, pixel_options(spp, seed));
   const double inv = 1.0 / spp;
   for (int i = 0; i < r.film.bins() * 3; ++i)
     if (static_cast<float>(m.acc.bins[static_cast<size_t>(i)] * inv) != r.film.transient()[i]) return false;
@@ -416,13 +411,13 @@ int convergence(const Options& opt) {
       est.assign(static_cast<size_t>(bins), 0.0);
       for (int i = 0; i < bins; ++i) {
         double frame_total = 0;
-        const std::vector<double> f = render_pixel(*scenes[static_cast<size_t>(t.m)], n / bins,
+        const std::vector<double> f = render_one(*scenes[static_cast<size_t>(t.m)], n / bins,
                                                    mix(seed ^ mix(static_cast<uint64_t>(i) + 77)), frame_total);
         est[static_cast<size_t>(i)] = f[static_cast<size_t>(i)];
         total += frame_total / bins;
       }
     } else {
-      est = render_pixel(*scenes[static_cast<size_t>(t.m)], n, seed, total);
+      est = render_one(*scenes[static_cast<size_t>(t.m)], n, seed, total);
     }
     const double secs = thread_cpu_s() - start;
     double e2 = 0;
