@@ -49,7 +49,8 @@ const char* kRenderHelp =
     "  --knn K            kernel film: k of the k-nearest-arrival initial bandwidth (default 40)\n"
     "  --first-pass-spp N kernel film: samples whose arrival times set the bandwidth (default\n"
     "                     160; all samples when spp is lower)\n"
-    "  --bandwidth PS     kernel film: initial bandwidth T_1 in ps instead of the k-NN choice\n"
+    "  --bandwidth PS     kernel film: initial bandwidth T_1 in ps instead of the k-NN choice\n"    "  --no-onset-reflection  kernel film: let kernels spill before the pixel's earliest\n"
+    "                     first-pass arrival instead of reflecting them there\n"
     "  --max-depth N      safety bound on scattering/bounce vertices per path; paths stopped by\n"
     "                     it are counted in render.json (scene default: 1000)\n"
     "  --out DIR          output folder, created if missing (default ./femto-out)\n"
@@ -94,6 +95,7 @@ nlohmann::json reconstruction_json(const ReconstructionDesc& r, const RenderResu
     j["initial_bandwidth"] = "k nearest arrivals of the first pass, per pixel";
     j["k"] = r.knn;
     j["first_pass_spp"] = r.first_pass_spp;
+    j["onset_reflection"] = r.onset_reflection;
   }
   std::vector<float> T = result.final_bandwidth_ps;
   if (!T.empty()) {
@@ -117,6 +119,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   std::optional<DirectionSampling> direction;
   std::optional<TemporalKernel> kernel;
   std::optional<double> alpha, bandwidth;
+  bool no_onset_reflection = false;
   std::optional<int> knn, first_pass_spp;
   std::string kernel_flag;  // the first kernel-only flag given, for the error message
   int threads = 0;
@@ -175,6 +178,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     } else if (a == "--bandwidth") {
       bandwidth = args.number_in(0.0, 1e12, true, false, "in (0, 1e12] ps");
       if (kernel_flag.empty()) kernel_flag = a;
+    } else if (a == "--no-onset-reflection") {
+      no_onset_reflection = true;
+      if (kernel_flag.empty()) kernel_flag = a;
     } else if (a == "--max-depth") {
       max_depth = static_cast<int>(args.int_value(1, 1000000));
     } else if (a == "--out") {
@@ -227,6 +233,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   if (knn) rec.knn = *knn;
   if (first_pass_spp) rec.first_pass_spp = *first_pass_spp;
   if (bandwidth) rec.bandwidth_ps = *bandwidth;
+  if (no_onset_reflection) rec.onset_reflection = false;
   RenderOptions opt;
   opt.spp = spp.value_or(desc.integrator.spp);
   opt.seed = seed.value_or(desc.integrator.seed);

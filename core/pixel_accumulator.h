@@ -2,6 +2,7 @@
 // One pixel's running sums over its samples, and the per-sample state of the kernel film.
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "core/reconstruction.h"
@@ -22,6 +23,8 @@ struct PixelAccumulator {
   int knn = 40;
   double cap_ps = 0.0;       ///< widest useful kernel (the window length)
   double fallback_ps = 0.0;  ///< base when the first pass had no arrival
+  double floor_ps =
+      -std::numeric_limits<double>::infinity();  ///< onset: earliest first-pass arrival
   /// First pass of a k-NN kernel film: deposits wait here until the bandwidth is known.
   struct Held {
     double t_ps, sigma_ps;
@@ -38,6 +41,7 @@ struct PixelAccumulator {
     before = after = RGB(0.0);
     kernel = hold = false;
     scale = 1.0;
+    floor_ps = -std::numeric_limits<double>::infinity();
     held.clear();
     times.clear();
   }
@@ -59,7 +63,7 @@ struct PixelAccumulator {
   }
   void add_now(const TemporalFilter& filter, double t_ps, double sigma_ps, const RGB& value,
                double T) {
-    const DepositSplit split = filter.deposit(t_ps, sigma_ps, value, bins.data(), T);
+    const DepositSplit split = filter.deposit(t_ps, sigma_ps, value, bins.data(), T, floor_ps);
     if (split.before > 0) before += value * split.before;
     if (split.after > 0) after += value * split.after;
   }

@@ -19,10 +19,12 @@ struct ReconstructionDesc {
   TemporalKernel kernel = TemporalKernel::Perlin;
   double alpha = 0.8;  ///< bandwidth shrinking exponent in (0, 1]; 1 keeps T fixed (biased)
   int knn = 40;        ///< k of the k-nearest-arrival bandwidth
-  int first_pass_spp =
-      160;  ///< samples per pixel whose arrival times set the bandwidth (several k)
-  double bandwidth_ps =
-      0.0;  ///< user-given T_1 > 0 for every arrival; 0 = k-nearest-arrival bandwidth
+  /// Samples per pixel whose arrival times set the bandwidth (several k).
+  int first_pass_spp = 160;
+  /// User-given T_1 > 0 for every arrival; 0 = k-nearest-arrival bandwidth.
+  double bandwidth_ps = 0.0;
+  /// Reflect kernel mass that would precede the pixel's earliest first-pass arrival (its onset).
+  bool onset_reflection = true;
 };
 
 /// Ratio T_j / T_1 = prod_{i=1}^{j-1} (i + alpha) / (i + 1), updated one sample at a time.

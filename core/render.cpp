@@ -64,6 +64,7 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
     acc.hold = false;
     for (const PixelAccumulator::Held& h : acc.held) acc.times.push_back(h.t_ps);
     std::sort(acc.times.begin(), acc.times.end());
+    if (rec.onset_reflection && !acc.times.empty()) acc.floor_ps = acc.times.front();
     for (const PixelAccumulator::Held& h : acc.held) {  // in sample order
       while (schedule.j() < h.sample + 1) schedule.advance();
       acc.scale = norm * schedule.ratio();

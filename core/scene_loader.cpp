@@ -567,7 +567,7 @@ class Loader {
 
   // "histogram", or {"type": "kernel", "kernel", "alpha", "k", "first_pass_spp", "bandwidth"}.
   void reconstruction(const Json& v, const std::string& p, ReconstructionDesc& r) const {
-    const Keys kernel_keys = {"kernel", "alpha", "k", "first_pass_spp", "bandwidth"};
+    const Keys kernel_keys = {"kernel", "alpha", "k", "first_pass_spp", "bandwidth", "onset_reflection"};
     if (v.is_string()) {
       r.type = choice(v, p, {"histogram", "kernel"}) == "kernel" ? TemporalFilter::Kind::Kernel
                                                                  : TemporalFilter::Kind::Histogram;
@@ -589,6 +589,10 @@ class Loader {
     if (const Json* k = find(o, "k")) r.knn = int_in(*k, at(p, "k"), 1, 100000);
     if (const Json* f = find(o, "first_pass_spp")) r.first_pass_spp = int_in(*f, at(p, "first_pass_spp"), 1, 1000000);
     if (const Json* b = find(o, "bandwidth")) r.bandwidth_ps = number(*b, at(p, "bandwidth"), above(0));
+    if (const Json* f = find(o, "onset_reflection")) {
+      if (!f->is_boolean()) fail(at(p, "onset_reflection"), "expected true or false", *f);
+      r.onset_reflection = f->get<bool>();
+    }
   }
 
   void media(const Json& v, SceneDesc& scene) const {

@@ -6,6 +6,7 @@
 // exactly as well.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/spectrum.h"
 #include "core/temporal_kernel.h"
@@ -37,11 +38,17 @@ class TemporalFilter {
   /// A kernel filter with bandwidth T > 0 spreads a delta arrival by K_T; a Gaussian arrival gets
   /// the Gaussian whose variance is the pulse's plus the kernel's (exact in energy and variance,
   /// not in shape; the bias still vanishes as T -> 0). T <= 0 deposits like the histogram.
+  /// `floor_ps`: the pixel's onset (no light before it); kernel mass that would fall before
+  /// min(floor, t) is reflected back above it, which keeps the deposit's energy and removes
+  /// the kernel's spill ahead of a causal onset. -inf: none.
   DepositSplit deposit(double t_ps, double sigma_ps, const RGB& value, double* bins,
-                       double bandwidth_ps = 0.0) const {
+                       double bandwidth_ps = 0.0,
+                       double floor_ps = -std::numeric_limits<double>::infinity()) const {
     if (kind_ == Kind::Kernel && bandwidth_ps > 0.0) {
-      if (sigma_ps <= 0.0) return deposit_kernel(t_ps, bandwidth_ps, value, bins);
-      sigma_ps = std::sqrt(sigma_ps * sigma_ps + kernel_variance(kernel_) * bandwidth_ps * bandwidth_ps);
+      if (sigma_ps <= 0.0)
+        return deposit_kernel(t_ps, bandwidth_ps, std::fmin(floor_ps, t_ps), value, bins);
+      sigma_ps =
+          std::sqrt(sigma_ps * sigma_ps + kernel_variance(kernel_) * bandwidth_ps * bandwidth_ps);
     }
     return deposit_histogram(t_ps, sigma_ps, value, bins);
   }
@@ -49,7 +56,8 @@ class TemporalFilter {
   static double gaussian_cdf(double z) { return 0.5 * std::erfc(-z * 0.70710678118654752440); }
 
  private:
-  DepositSplit deposit_histogram(double t_ps, double sigma_ps, const RGB& value, double* bins) const {
+  DepositSplit deposit_histogram(double t_ps, double sigma_ps, const RGB& value,
+                                 double* bins) const {
     DepositSplit split;
     if (sigma_ps <= 0.0) {
       const int i = axis_.bin_of(t_ps);
@@ -83,19 +91,29 @@ class TemporalFilter {
     return split;
   }
 
-  /// K_T(. - t) integrated over each bin of [t - T, t + T] by kernel CDF differences.
-  DepositSplit deposit_kernel(double t_ps, double T, const RGB& value, double* bins) const {
+  /// K_T(. - t) integrated over each bin of [t - T, t + T] by kernel CDF differences; with a
+  /// floor tf <= t inside the support, the reflected kernel K_T(. - t) + K_T(2 tf - . - t) on
+  /// [tf, inf), whose CDF is F((x - t) / T) - F((2 tf - x - t) / T).
+  DepositSplit deposit_kernel(double t_ps, double T, double tf, const RGB& value,
+                              double* bins) const {
     const double t0 = axis_.t_start_ps, w = axis_.bin_width_ps, t_end = axis_.t_end_ps();
+    const bool reflect = t_ps - T < tf;
+    auto G = [&](double x) {
+      if (!reflect) return kernel_cdf(kernel_, (x - t_ps) / T);
+      return x <= tf ? 0.0
+                     : kernel_cdf(kernel_, (x - t_ps) / T) -
+                           kernel_cdf(kernel_, (2.0 * tf - x - t_ps) / T);
+    };
     DepositSplit split;
-    split.before = kernel_cdf(kernel_, (t0 - t_ps) / T);
-    split.after = 1.0 - kernel_cdf(kernel_, (t_end - t_ps) / T);
-    const double lo = std::fmax(t0, t_ps - T), hi = std::fmin(t_end, t_ps + T);
+    split.before = G(t0);
+    split.after = 1.0 - G(t_end);
+    const double lo = std::fmax(t0, reflect ? tf : t_ps - T), hi = std::fmin(t_end, t_ps + T);
     if (lo >= hi) return split;
     int i = static_cast<int>((lo - t0) / w);
     const int i_end = std::min(axis_.bins - 1, static_cast<int>((hi - t0) / w));
-    double cdf_prev = kernel_cdf(kernel_, (t0 + i * w - t_ps) / T);
+    double cdf_prev = G(t0 + i * w);
     for (; i <= i_end; ++i) {
-      const double cdf_next = kernel_cdf(kernel_, (t0 + (i + 1) * w - t_ps) / T);
+      const double cdf_next = G(t0 + (i + 1) * w);
       const double f = cdf_next - cdf_prev;
       cdf_prev = cdf_next;
       if (f > 0.0) add(bins, i, value, f);

@@ -321,6 +321,7 @@ TEST_CASE("cli: --reconstruction kernel records its settings and keeps the histo
   CHECK(rec["alpha"].get<double>() == 0.7);
   CHECK(rec["k"].get<int>() == 12);        // the scene's key survives
   CHECK(rec["first_pass_spp"].get<int>() == 160);
+  CHECK(rec["onset_reflection"].get<bool>());
   CHECK(json::parse(read_text(hout / "render.json"))["settings"]["reconstruction"]["type"] == "histogram");
   CHECK_FALSE(fs::exists(hout / "kernel_bandwidth.exr"));
 

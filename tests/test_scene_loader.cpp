@@ -428,14 +428,18 @@ TEST_CASE("scene loader: temporal reconstruction", "[scene_loader]") {
   CHECK(r.knn == 40);
   CHECK(r.first_pass_spp == 160);
   CHECK(r.bandwidth_ps == 0.0);
-  j["time"]["reconstruction"] = {{"type", "kernel"}, {"kernel", "epanechnikov"}, {"alpha", 1},
-                                 {"k", 7}, {"first_pass_spp", 9}, {"bandwidth", 12.5}};
+  CHECK(r.onset_reflection);
+  j["time"]["reconstruction"] = {{"type", "kernel"}, {"kernel", "epanechnikov"}, {"alpha", 1}, {"k", 7},
+                                 {"first_pass_spp", 9}, {"bandwidth", 12.5}, {"onset_reflection", false}};
   r = load(j).reconstruction;
   CHECK(r.kernel == femto::TemporalKernel::Epanechnikov);
   CHECK(r.alpha == 1.0);
   CHECK(r.knn == 7);
   CHECK(r.first_pass_spp == 9);
   CHECK(r.bandwidth_ps == 12.5);
+  CHECK_FALSE(r.onset_reflection);
+  j["time"]["reconstruction"] = {{"type", "kernel"}, {"onset_reflection", "yes"}};
+  CHECK_THAT(error_of(j), Contains("/time/reconstruction/onset_reflection: expected true or false"));
 
   j["time"]["reconstruction"] = {{"type", "kernel"}, {"alpha", 0}};
   CHECK_THAT(error_of(j), Contains("/time/reconstruction/alpha: must be in (0, 1] (got 0)"));
