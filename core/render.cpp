@@ -55,8 +55,8 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
   // First pass: its arrival times set the bandwidth, anchored (r_j / r_P) so that its last
   // sample uses the k-NN distance itself.
   const int first_pass = rec.bandwidth_ps <= 0.0 ? std::min(opt.spp, rec.first_pass_spp) : 0;
-  const double norm =
-      first_pass > 0 ? 1.0 / BandwidthSchedule::ratio_at(rec.alpha, first_pass) : 1.0;
+  const double ratio_P = BandwidthSchedule::ratio_at(rec.alpha, std::max(1, first_pass));
+  const double norm = first_pass > 0 ? 1.0 / ratio_P : 1.0;
   BandwidthSchedule schedule(rec.alpha);
   if (first_pass > 0) {
     acc.hold = true;
@@ -77,8 +77,9 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
     trace_sample(s);
     schedule.advance();
   }
-  acc.scale = norm * BandwidthSchedule::ratio_at(
-                         rec.alpha, opt.spp);  // the last sample's, for typical_bandwidth
+  // For typical_bandwidth: the progressive loop left the last sample's scale; a pixel that was
+  // all first pass ends at sample P.
+  if (first_pass >= opt.spp) acc.scale = norm * ratio_P;
 }
 
 RenderResult render(const Scene& scene, const RenderOptions& opt) {

@@ -22,6 +22,24 @@ void connection_window(const TimeAxis& axis, const Light& L, double t, double& t
   t_a = axis.t_start_ps - t - L.pulse.offset_ps - spread;
   t_b = axis.t_end_ps() - t - L.pulse.offset_ps + spread;
 }
+
+/// Angular time sampling from x towards light L for a segment of length r, restricted to the
+/// connection times that keep the contribution in the film window.
+struct AngularTarget {
+  Vec3 to;   ///< x -> light
+  double l;  ///< |to|
+  AngularTimeSampler sampler;
+  AngularTimeSampler::Window win;
+};
+AngularTarget angular_target(const TimeAxis& axis, const Light& L, const Vec3& x, double r,
+                             double eta, double t) {
+  double t_a, t_b;
+  connection_window(axis, L, t, t_a, t_b);
+  const Vec3 to = L.position - x;
+  const double l = length(to);
+  const AngularTimeSampler sampler(r, l, eta);
+  return {to, l, sampler, sampler.window(t_a, t_b)};
+}
 }  // namespace
 
 VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& med, const Vec3& x,
@@ -43,10 +61,8 @@ VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& m
   const LightSet& lights = scene_.lights();
   for (size_t k = 0; k < point_lights_.size(); ++k) {
     const Light& L = lights.light(point_lights_[k]);
-    double t_a, t_b;
-    connection_window(filter_.axis(), L, t, t_a, t_b);
-    const AngularTimeSampler sampler(mix.r_aux, length(L.position - x), mix.eta);
-    if (sampler.window(t_a, t_b).valid) mix.valid_pmf += point_pmf_[k];
+    if (angular_target(filter_.axis(), L, x, mix.r_aux, mix.eta, t).win.valid)
+      mix.valid_pmf += point_pmf_[k];
   }
   mix.active = mix.valid_pmf > 0;
   return mix;
@@ -56,16 +72,11 @@ double VolPathIntegrator::angular_pdf(const DirectionMix& mix, const Vec3& x, co
   const LightSet& lights = scene_.lights();
   double pdf = 0;
   for (size_t k = 0; k < point_lights_.size(); ++k) {
-    const Light& L = lights.light(point_lights_[k]);
-    double t_a, t_b;
-    connection_window(filter_.axis(), L, mix.t, t_a, t_b);
-    const Vec3 to = L.position - x;
-    const double l = length(to);
-    const AngularTimeSampler sampler(mix.r_aux, l, mix.eta);
-    const AngularTimeSampler::Window win = sampler.window(t_a, t_b);
-    if (!win.valid || !(l > 0)) continue;
+    const AngularTarget a = angular_target(filter_.axis(), lights.light(point_lights_[k]), x,
+                                           mix.r_aux, mix.eta, mix.t);
+    if (!a.win.valid || !(a.l > 0)) continue;
     pdf += point_pmf_[k] / mix.valid_pmf *
-           sampler.pdf_solid_angle(win, AngularTimeSampler::one_minus_cos(to / l, w));
+           a.sampler.pdf_solid_angle(a.win, AngularTimeSampler::one_minus_cos(a.to / a.l, w));
   }
   return pdf;
 }
@@ -92,23 +103,18 @@ double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& 
     const LightSet& lights = scene_.lights();
     double u = (u_pick - 0.5) * 2.0 * mix.valid_pmf;
     size_t chosen = point_lights_.size();
-    AngularTimeSampler::Window win;
     for (size_t k = 0; k < point_lights_.size(); ++k) {
-      const Light& L = lights.light(point_lights_[k]);
-      double t_a, t_b;
-      connection_window(filter_.axis(), L, mix.t, t_a, t_b);
-      const AngularTimeSampler::Window wk =
-          AngularTimeSampler(mix.r_aux, length(L.position - x), mix.eta).window(t_a, t_b);
-      if (!wk.valid) continue;
+      if (!angular_target(filter_.axis(), lights.light(point_lights_[k]), x, mix.r_aux, mix.eta,
+                          mix.t)
+               .win.valid)
+        continue;
       chosen = k;
-      win = wk;
       if (u < point_pmf_[k]) break;
       u -= point_pmf_[k];
     }
-    const Light& L = lights.light(point_lights_[chosen]);
-    const Vec3 to = L.position - x;
-    const double l = length(to);
-    w = AngularTimeSampler(mix.r_aux, l, mix.eta).sample_direction(to / l, win, u1, u2);
+    const AngularTarget a = angular_target(filter_.axis(), lights.light(point_lights_[chosen]), x,
+                                           mix.r_aux, mix.eta, mix.t);
+    w = a.sampler.sample_direction(a.to / a.l, a.win, u1, u2);
   }
   pdf = direction_pdf(mix, x, d, g, w);
   return pdf > 0 ? hg_eval(dot(d, w), g) / pdf : 0.0;
