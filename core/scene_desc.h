@@ -34,11 +34,16 @@ struct CameraDesc {
 };
 
 struct MaterialDesc {
-  enum class Type { None, Diffuse, Mirror, Dielectric };
+  enum class Type { None, Diffuse, Mirror, Dielectric, RoughDielectric, RoughConductor };
   Type type = Type::None;        ///< None: an index-matched boundary that only bounds a medium
   RGB albedo{0.5};               ///< diffuse reflectance
-  RGB reflectance{1.0};          ///< mirror reflectance
-  double eta = 1.5;              ///< dielectric: refractive index of the interior
+  RGB reflectance{1.0};          ///< mirror reflectance; rough conductor: reflectance at normal incidence
+  double eta = 1.5;              ///< dielectric, rough dielectric: refractive index of the interior
+  double roughness = 0.1;        ///< rough dielectric, rough conductor: GGX alpha (0 < alpha <= 1)
+  /// Whether the material scatters light into a single direction (a delta BSDF).
+  bool is_specular() const { return type == Type::Mirror || type == Type::Dielectric; }
+  /// Whether light can pass through it into the shape's interior.
+  bool is_transmissive() const { return type == Type::Dielectric || type == Type::RoughDielectric; }
 };
 
 /// How collision distances are sampled in a medium.
@@ -129,10 +134,31 @@ struct LightDesc {
   PulseDesc pulse;
 };
 
+/// Which estimators render the image (docs/outputs.md, "Integrators").
+enum class IntegratorKind {
+  Auto,     ///< path + photons when the scene has delta lights and non-diffuse surfaces, else path
+  Path,     ///< camera paths only (volumetric path tracing)
+  Light,    ///< light paths connected to the camera (light tracing)
+  Photons   ///< camera paths + transient progressive photon mapping for caustics on diffuse surfaces
+};
+
+/// Transient progressive photon mapping on surfaces (one pass = photons + one camera sample per pixel).
+struct PhotonDesc {
+  int64_t per_pass = 200000;     ///< photons emitted per pass
+  double radius = 0.0;           ///< initial gather radius R_1, mm; 0 = automatic (scene size)
+  double bandwidth_ps = 0.0;     ///< initial temporal bandwidth T_1, ps; 0 = automatic (4 bins)
+  double alpha = 4.0 / 7.0;      ///< kernel volume ratio per pass, (j + alpha) / (j + 1)
+  double beta_t = 1.0 / 3.0;     ///< share of the shrinkage given to time (beta_R = 1 - beta_t)
+  TemporalKernel kernel = TemporalKernel::Epanechnikov;
+};
+
 struct IntegratorDesc {
   int spp = 16;
   int max_depth = 1000;          ///< safety bound on scattering/bounce vertices per path
   uint64_t seed = 1;
+  IntegratorKind kind = IntegratorKind::Auto;
+  int64_t light_paths = 0;       ///< light tracing: paths in all; 0 = spp x width x height
+  PhotonDesc photons;
 };
 
 struct SceneDesc {
