@@ -11,6 +11,7 @@
 #include "apps/commands.h"
 #include "core/default_scene.h"
 #include "core/error.h"
+#include "core/integrators/photon_map.h"
 #include "core/outputs.h"
 #include "core/progress.h"
 #include "core/render.h"
@@ -51,6 +52,15 @@ const char* kRenderHelp =
     "                     160; all samples when spp is lower)\n"
     "  --bandwidth PS     kernel film: initial bandwidth T_1 in ps instead of the k-NN choice\n"    "  --no-onset-reflection  kernel film: let kernels spill before the pixel's earliest\n"
     "                     first-pass arrival instead of reflecting them there\n"
+    "  --integrator I     auto (default: path + photons when the scene has point, spot or laser\n"
+    "                     lights and non-diffuse surfaces, else path), path (camera paths\n"
+    "                     only), light (light paths splatted to the camera) or photons\n"
+    "                     (camera paths + transient progressive photon mapping of caustics)\n"
+    "  --light-paths N    light tracing: light paths in all (default spp x pixels)\n"
+    "  --photons N        photon mapping: photons per pass (default 200000); passes = spp\n"
+    "  --photon-radius MM photon mapping: initial gather radius R_1 (default 0.5% of the\n"
+    "                     bounding-box diagonal of the scene)\n"
+    "  --photon-bandwidth PS  photon mapping: initial temporal bandwidth T_1 (default 1 bin)\n"
     "  --max-depth N      safety bound on scattering/bounce vertices per path; paths stopped by\n"
     "                     it are counted in render.json (scene default: 1000)\n"
     "  --out DIR          output folder, created if missing (default ./femto-out)\n"
@@ -105,6 +115,42 @@ nlohmann::json reconstruction_json(const ReconstructionDesc& r, const RenderResu
   return j;
 }
 
+nlohmann::json integrator_json(IntegratorKind kind, const std::string& why, const RenderOptions& opt,
+                               const RenderResult& result) {
+  nlohmann::json j = {{"type", integrator_name(kind)}, {"why", why}};
+  switch (kind) {
+    case IntegratorKind::Path:
+      j["description"] = "camera paths: distance sampling per medium, next-event estimation, MIS with BSDF sampling";
+      break;
+    case IntegratorKind::Light:
+      j["description"] = "light paths, every non-delta vertex connected to the camera";
+      j["light_paths"] = result.light_paths;
+      break;
+    case IntegratorKind::Photons: {
+      const auto& p = result.photons;
+      j["description"] =
+          "camera paths + transient progressive photon mapping: photons that reach a diffuse surface through "
+          "non-diffuse surfaces are gathered there; camera paths leave those paths out";
+      j["passes"] = p.passes;
+      j["camera_samples_per_pass"] = 1;
+      j["photons_per_pass"] = p.per_pass;
+      j["radius_mm"] = {{"first_pass", p.radius_first}, {"last_pass", p.radius_last}};
+      j["bandwidth_ps"] = {{"first_pass", p.bandwidth_first_ps}, {"last_pass", p.bandwidth_last_ps}};
+      j["alpha"] = opt.photons.alpha;
+      j["beta_t"] = opt.photons.beta_t;
+      j["temporal_kernel"] = opt.photons.kernel == TemporalKernel::Perlin ? "perlin" : "epanechnikov";
+      j["spatial_kernel"] = "disc, 1 / (pi R^2)";
+      j["schedule"] = "R_{j+1}^2 = R_j^2 ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_t";
+      j["max_photons_stored_per_pass"] = p.max_stored_per_pass;
+      j["photon_memory_bytes_peak"] = p.peak_photon_bytes;
+      break;
+    }
+    case IntegratorKind::Auto:
+      break;
+  }
+  return j;
+}
+
 }  // namespace
 
 namespace {
@@ -122,6 +168,10 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   bool no_onset_reflection = false;
   std::optional<int> knn, first_pass_spp;
   std::string kernel_flag;  // the first kernel-only flag given, for the error message
+  std::optional<IntegratorKind> integrator;
+  std::optional<int64_t> light_paths, photons_per_pass;
+  std::optional<double> photon_radius, photon_bandwidth;
+  std::string photon_flag;  // the first photon-only flag given, for the error message
   int threads = 0;
   OutputOptions out;
   bool quiet = false;
@@ -181,6 +231,24 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     } else if (a == "--no-onset-reflection") {
       no_onset_reflection = true;
       if (kernel_flag.empty()) kernel_flag = a;
+    } else if (a == "--integrator") {
+      const std::string v = args.value();
+      if (v == "auto") integrator = IntegratorKind::Auto;
+      else if (v == "path") integrator = IntegratorKind::Path;
+      else if (v == "light") integrator = IntegratorKind::Light;
+      else if (v == "photons") integrator = IntegratorKind::Photons;
+      else args.fail("expected auto, path, light or photons", v);
+    } else if (a == "--light-paths") {
+      light_paths = static_cast<int64_t>(args.int_value(1, 1000000000000LL));
+    } else if (a == "--photons") {
+      photons_per_pass = static_cast<int64_t>(args.int_value(1, 1000000000LL));
+      if (photon_flag.empty()) photon_flag = a;
+    } else if (a == "--photon-radius") {
+      photon_radius = args.number_in(0.0, 1e9, true, false, "in (0, 1e9] mm");
+      if (photon_flag.empty()) photon_flag = a;
+    } else if (a == "--photon-bandwidth") {
+      photon_bandwidth = args.number_in(0.0, 1e12, true, false, "in (0, 1e12] ps");
+      if (photon_flag.empty()) photon_flag = a;
     } else if (a == "--max-depth") {
       max_depth = static_cast<int>(args.int_value(1, 1000000));
     } else if (a == "--out") {
@@ -234,7 +302,28 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   if (first_pass_spp) rec.first_pass_spp = *first_pass_spp;
   if (bandwidth) rec.bandwidth_ps = *bandwidth;
   if (no_onset_reflection) rec.onset_reflection = false;
+  if (integrator) desc.integrator.kind = *integrator;
+  if (light_paths) desc.integrator.light_paths = *light_paths;
+  PhotonDesc& pd = desc.integrator.photons;
+  if (photons_per_pass) pd.per_pass = *photons_per_pass;
+  if (photon_radius) pd.radius = *photon_radius;
+  if (photon_bandwidth) pd.bandwidth_ps = *photon_bandwidth;
+  std::string integrator_why;
+  const IntegratorKind kind = resolve_integrator(desc, desc.integrator.kind, integrator_why);
+  const std::string where = scene_path.empty() ? "femto render" : scene_path;
+  if (kind != IntegratorKind::Path && rec.type == TemporalFilter::Kind::Kernel)
+    throw InputError(where + ": integrator \"" + integrator_name(kind) +
+                     "\": the kernel film (/time/reconstruction kernel) works with camera paths only; use "
+                     "--integrator path or the histogram film");
+  if (!photon_flag.empty() && kind != IntegratorKind::Photons)
+    throw InputError("femto render: " + photon_flag + ": applies to photon mapping only, but the integrator is \"" +
+                     integrator_name(kind) + "\"; add --integrator photons");
+  if (light_paths && kind != IntegratorKind::Light)
+    throw InputError("femto render: --light-paths: applies to --integrator light only");
   RenderOptions opt;
+  opt.integrator = kind;
+  opt.light_paths = desc.integrator.light_paths;
+  opt.photons = pd;
   opt.spp = spp.value_or(desc.integrator.spp);
   opt.seed = seed.value_or(desc.integrator.seed);
   opt.max_depth = max_depth.value_or(desc.integrator.max_depth);
@@ -243,6 +332,17 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   const CameraDesc& cam = desc.camera;
   const TimeAxis axis = desc.time;
   const uint64_t film_bytes = TransientFilm::memory_bytes(cam.width, cam.height, axis.bins);
+  // Light tracing and photons sum every pixel over the whole render in double precision, and a
+  // photon pass may keep every photon it emits.
+  const uint64_t pixel_bins = static_cast<uint64_t>(cam.width) * static_cast<uint64_t>(cam.height) *
+                              (static_cast<uint64_t>(axis.bins) + 2) * 3;
+  uint64_t extra_bytes = kind == IntegratorKind::Path ? 0 : pixel_bins * sizeof(double);
+  if (kind == IntegratorKind::Photons) extra_bytes += photon_pass_bytes(pd.per_pass);
+  if (film_bytes + extra_bytes > max_memory)
+    throw InputError("render needs " + cli::format_bytes(film_bytes + extra_bytes) + " (film " +
+                     cli::format_bytes(film_bytes) + ", integrator buffers " + cli::format_bytes(extra_bytes) +
+                     "), more than --max-memory " + cli::format_bytes(max_memory) +
+                     ": lower the resolution, the number of bins or photons per pass, or raise --max-memory");
   if (film_bytes > max_memory)
     throw InputError("film needs " + cli::format_bytes(film_bytes) + " (" + std::to_string(cam.width) +
                      " x " + std::to_string(cam.height) + " pixels x " + std::to_string(axis.bins) +
@@ -268,7 +368,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"seed", opt.seed},
                       {"threads", result.threads},
                       {"max_depth", opt.max_depth},
-                      {"integrator", "volpath (mean-free-path sampling, NEE + MIS)"},
+                      {"integrator", integrator_json(kind, integrator_why, opt, result)},
                       {"reconstruction", reconstruction_json(scene.desc().reconstruction, result)},
                       {"russian_roulette", false}};
   nlohmann::json media = nlohmann::json::array();
@@ -311,7 +411,10 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"surface_events", st.surface_events},
                       {"null_boundary_crossings", st.null_crossings},
                       {"max_depth_terminations", st.max_depth_hits},
-                      {"nonfinite_samples_dropped", st.nonfinite_dropped}};
+                      {"nonfinite_samples_dropped", st.nonfinite_dropped},
+                      {"light_paths", st.light_paths},
+                      {"photons_stored", st.photons_stored},
+                      {"photon_gathers", st.photon_gathers}};
   info["timing"] = {{"render_seconds", result.wall_seconds},
                     {"paths_per_second", result.wall_seconds > 0 ? static_cast<double>(st.paths) / result.wall_seconds : 0.0}};
   info["energy"] = {{"in_window", rgb_json(result.film.total_steady())},

@@ -33,6 +33,36 @@ class Camera {
     return {desc_.position + right_ * sx + up_ * sy, forward_};
   }
 
+  /// Connection of a world point x to the sensor (light tracing): film position (fx, fy) in
+  /// pixels, unit direction from x to the sensor, its length, and the importance W of one pixel
+  /// such that a light vertex adds beta f |cos_x| Tr W to that pixel's mean radiance. With the
+  /// film as the plane at unit distance and A_pix its area per pixel: perspective W =
+  /// 1 / (A_pix cos^3(theta) dist^2), orthographic W = 1 / A_pix (dist = depth along the axis).
+  /// False when x is behind the sensor or projects outside the film.
+  bool connect_to(const Vec3& x, double& fx, double& fy, Vec3& w_to_sensor, double& dist, double& W) const {
+    const bool persp = desc_.type == CameraDesc::Type::Perspective;
+    const Vec3 v = x - desc_.position;
+    const double z = dot(v, forward_);
+    if (!(z > 0)) return false;
+    const double sx = persp ? dot(v, right_) / z : dot(v, right_);
+    const double sy = persp ? dot(v, up_) / z : dot(v, up_);
+    fx = (sx / half_w_ + 1.0) * 0.5 * desc_.width;
+    fy = (1.0 - sy / half_h_) * 0.5 * desc_.height;
+    if (!(fx >= 0 && fx < desc_.width && fy >= 0 && fy < desc_.height)) return false;
+    const double a_pix = 4.0 * half_w_ * half_h_ / (static_cast<double>(desc_.width) * desc_.height);
+    if (persp) {
+      dist = length(v);
+      w_to_sensor = -v / dist;
+      const double cos_t = z / dist;
+      W = 1.0 / (a_pix * cos_t * cos_t * cos_t * dist * dist);
+    } else {
+      dist = z;
+      w_to_sensor = -forward_;
+      W = 1.0 / a_pix;
+    }
+    return true;
+  }
+
   int width() const { return desc_.width; }
   int height() const { return desc_.height; }
 

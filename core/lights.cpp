@@ -182,6 +182,73 @@ bool LightSet::sample(int i, const Vec3& x, double u1, double u2, LightSample& l
   return false;
 }
 
+namespace {
+/// Uniform point on an emitting mesh (triangle by area, then uniform in it) and its front normal.
+void sample_mesh_point(const ShapeDesc& sh, const std::vector<double>& tri_cdf, double u1, double u2, Vec3& p, Vec3& n) {
+  const auto it = std::upper_bound(tri_cdf.begin(), tri_cdf.end(), u1);
+  const size_t t = std::min(static_cast<size_t>(it - tri_cdf.begin()), tri_cdf.size() - 1);
+  const double c0 = t == 0 ? 0.0 : tri_cdf[t - 1];
+  const double w = tri_cdf[t] - c0;
+  const double uu = w > 0 ? std::clamp((u1 - c0) / w, 0.0, 1.0 - 1e-16) : 0.5;
+  const auto& tri = sh.triangles[t];
+  const Vec3 &a = sh.vertices[tri[0]], &b = sh.vertices[tri[1]], &c = sh.vertices[tri[2]];
+  double b1, b2;
+  sample_uniform_triangle(uu, u2, b1, b2);
+  p = a * (1 - b1 - b2) + b * b1 + c * b2;
+  n = normalize(cross(b - a, c - a));
+}
+}  // namespace
+
+bool LightSet::sample_emission(int i, double u1, double u2, double u3, double u4, LightEmission& e) const {
+  const Light& l = lights_[static_cast<size_t>(i)];
+  e.area = false;
+  switch (l.type) {
+    case Light::Type::Point:
+      e.ray = {l.position, sample_uniform_sphere(u1, u2)};
+      e.beta = l.intensity * (4.0 * kPi);
+      return true;
+    case Light::Type::Spot: {
+      // Uniform in the cone's solid angle, weighted by the smooth falloff.
+      const double cos_t = 1.0 - u1 * (1.0 - l.cos_cone);
+      const double sin_t = std::sqrt(std::fmax(0.0, 1.0 - cos_t * cos_t));
+      const double phi = 2.0 * kPi * u2;
+      const Vec3 d = normalize(Frame(l.direction).to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t}));
+      const double falloff = smoothstep(l.cos_cone, l.cos_falloff, cos_t);
+      if (!(falloff > 0)) return false;
+      e.ray = {l.position, d};
+      e.beta = l.intensity * (falloff * 2.0 * kPi * (1.0 - l.cos_cone));
+      return true;
+    }
+    case Light::Type::Laser: {
+      double x, y;
+      sample_uniform_disc(u1, u2, x, y);
+      const Frame f(l.direction);
+      e.ray = {l.position + (f.s * x + f.t * y) * l.radius, l.direction};
+      e.beta = l.power;  // total flux, spread uniformly over the beam's cross-section
+      return true;
+    }
+    case Light::Type::AreaSphere:
+    case Light::Type::AreaMesh: {
+      Vec3 p, n;
+      if (l.type == Light::Type::AreaSphere) {
+        n = sample_uniform_sphere(u1, u2);
+        p = l.position + n * l.radius;
+      } else {
+        sample_mesh_point(scene_->shapes[static_cast<size_t>(l.shape)], l.tri_cdf, u1, u2, p, n);
+      }
+      if (!(l.area > 0)) return false;
+      const Vec3 local = sample_cosine_hemisphere(u3, u4);
+      e.ray = {p, normalize(Frame(n).to_world(local))};
+      e.n = n;
+      e.area = true;
+      e.Le_over_pdf_pos = l.emission * l.area;
+      e.beta = l.emission * (kPi * l.area);  // Le cos / ((1 / A) (cos / pi))
+      return true;
+    }
+  }
+  return false;
+}
+
 double LightSet::pdf_area(int i, const Vec3& x, const Vec3& p, const Vec3& n) const {
   const Light& l = lights_[static_cast<size_t>(i)];
   const Vec3 v = p - x;

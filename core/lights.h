@@ -18,6 +18,15 @@ struct LightSample {
   bool is_delta = false;
 };
 
+/// A ray leaving a light, for light paths and photons.
+struct LightEmission {
+  Ray ray;                 ///< origin on the light, unit direction of travel
+  Vec3 n;                  ///< area lights: unit normal at the origin
+  RGB beta;                ///< flux weight: emitted intensity or radiance x cos / (pdf_pos pdf_dir)
+  RGB Le_over_pdf_pos;     ///< area lights: emitted radiance / area pdf of the origin
+  bool area = false;
+};
+
 struct Light {
   enum class Type { Point, Spot, Laser, AreaMesh, AreaSphere };
   Type type = Type::Point;
@@ -44,6 +53,9 @@ class LightSet {
   double pmf(int i) const { return pmf_[static_cast<size_t>(i)]; }
   /// Samples light i as seen from x. False when it cannot reach x (outside a cone or beam).
   bool sample(int i, const Vec3& x, double u1, double u2, LightSample& ls) const;
+  /// Samples a ray leaving light i (position and direction from u1..u4). False if the light
+  /// emits nothing.
+  bool sample_emission(int i, double u1, double u2, double u3, double u4, LightEmission& e) const;
   /// Light index of an emissive shape, or -1.
   int light_of_shape(int shape) const {
     return shape >= 0 && shape < static_cast<int>(shape_light_.size()) ? shape_light_[static_cast<size_t>(shape)] : -1;

@@ -83,11 +83,13 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
 }
 
 RenderResult render(const Scene& scene, const RenderOptions& opt) {
+  if (opt.integrator == IntegratorKind::Light) return render_light(scene, opt);
+  if (opt.integrator == IntegratorKind::Photons) return render_photons(scene, opt);
   const auto start = std::chrono::steady_clock::now();
   const Camera& camera = scene.camera();
   const int W = camera.width(), H = camera.height();
   const TimeAxis axis = scene.desc().time;
-  RenderResult result{TransientFilm(W, H, axis), PathStats{}, 0.0, 0, {}};
+  RenderResult result{TransientFilm(W, H, axis), PathStats{}, 0.0, 0, {}, {}, 0};
   const ReconstructionDesc& rec = scene.desc().reconstruction;
   const bool kernel = rec.type == TemporalFilter::Kind::Kernel;
   const TemporalFilter filter(axis, rec.type, rec.kernel);

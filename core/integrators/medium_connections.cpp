@@ -158,7 +158,7 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
     if (!(p_sum > 0) || !(s < s_end)) return;
     const Vec3 y = ray.at(s);
     double tau, opl;
-    segment_integrals(m, ray, s, tau, opl);
+    tracker_.segment_integrals(m, ray, s, tau, opl);
     const double sigma_s = med.type == Medium::Type::Grid
                                ? med.grid->sigma_t_at(y) * med.grid->albedo_at(y)
                                : med.homogeneous.sigma_s;
@@ -167,7 +167,7 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
     if (!lights.sample(li, y, u1, u2, ls)) return;
     const double f = hg_eval(dot(ray.d, ls.wi), med.g());
     double Tr, dt;
-    if (!(f > 0) || !connect(y, m, ls.wi, ls.dist, Tr, dt, stats)) return;
+    if (!(f > 0) || !tracker_.connect(y, m, ls.wi, ls.dist, Tr, dt, stats)) return;
     const double weight = sigma_s * std::exp(-tau) * f * Tr / (p_sum * pmf * ls.pdf);
     deposit(t + opl * t_factor + dt + L.pulse.offset_ps, L.pulse.sigma_ps(), beta * ls.Li * weight,
             acc, stats);

@@ -1,61 +1,39 @@
 #pragma once
-// Transient volumetric path tracer: camera paths with mean-free-path distance sampling in
-// homogeneous media, next-event estimation through media and index-matched boundaries, and MIS
-// between light sampling and phase/BSDF sampling for area lights. Each contribution is stamped
-// with its path's time of flight (sum of eta * length / c over segments, plus the light's
-// emission time) and deposited into the pixel's time bins.
+// Transient volumetric path tracer: camera paths through media and surfaces (core/bsdf),
+// next-event estimation through media and index-matched boundaries, and MIS between light
+// sampling and phase/BSDF sampling for area lights. Each contribution is stamped with its path's
+// time of flight (sum of eta * length / c over segments, plus the light's emission time) and
+// deposited into the pixel's time bins. With a photon pass (core/integrators/photon_map.h) the
+// tracer gathers caustic photons at diffuse surfaces and leaves those paths to them.
 #include <cstdint>
 #include <vector>
 
+#include "core/bsdf/bsdf.h"
 #include "core/pixel_accumulator.h"
 #include "core/rng.h"
 #include "core/scene.h"
 #include "core/temporal_filter.h"
+#include "core/transport/tracker.h"
 #include "samplers/medium_distance.h"
 
 namespace femto {
 
-/// Counters of one render; integer sums, so merging per-thread copies is deterministic.
-struct PathStats {
-  uint64_t paths = 0;
-  uint64_t medium_events = 0;      ///< real scattering events in media
-  uint64_t surface_events = 0;     ///< reflections/refractions at surfaces
-  uint64_t null_crossings = 0;     ///< passes through index-matched boundaries
-  uint64_t max_depth_hits = 0;     ///< paths stopped by the max-depth safety bound
-  uint64_t nonfinite_dropped = 0;  ///< contributions dropped for being NaN or infinite
-  PathStats& operator+=(const PathStats& o);
-};
+struct PhotonGather;
 
 class VolPathIntegrator {
  public:
   VolPathIntegrator(const Scene& scene, const TemporalFilter& filter, int max_depth);
 
   /// Traces one camera path starting on `ray` (in the outside medium) and adds its
-  /// contributions to `acc`.
-  void trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
+  /// contributions to `acc`. With `photons`, caustic paths (light -> non-diffuse surfaces ->
+  /// diffuse surface) come from the photons gathered at diffuse vertices, not from this path.
+  void trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats,
+             const PhotonGather* photons = nullptr) const;
 
   /// Path time beyond which no contribution can reach the window, ps.
   double time_cutoff_ps() const { return t_cut_; }
 
  private:
-  /// Transmittance and time of flight of a straight connection x -> x + dist * wi starting in
-  /// medium m, passing through index-matched boundaries; false if an opaque or refracting
-  /// surface blocks it.
-  bool connect(const Vec3& x, int m, const Vec3& wi, double dist, double& Tr, double& time_ps,
-               PathStats& stats) const;
-  /// Collision sampling on one ray segment: `main` continues the path; under MIS `extra` is the
-  /// time-uniform collision, used for next-event estimation only.
-  struct MediumSample {
-    DistanceEvent main;
-    double main_nee_weight = 1.0;  ///< extra factor for next-event estimation at `main`
-    DistanceEvent extra;
-    double extra_nee_weight = 0.0;
-  };
-  /// Next collision in `med` along `ray` before s_max (a surface, or infinity).
-  /// `u_main` >= 0 replaces the main distance draw (angular direction sampling draws it early).
-  MediumSample sample_medium(const Medium& med, const Ray& ray, double s_max, Rng& rng, double u_main = -1) const;
-  template <class Segments>
-  MediumSample finish_sample(Segments& segments, const DistanceStrategy& st, double u1, Rng& rng) const;
   /// Angular direction sampling at a collision (one-sample MIS of phase and angular sampling):
   /// `u` is drawn before the direction and is also the next segment's raw distance draw, so
   /// r_aux (the segment length angular sampling assumes) is shared by every strategy's weights.
@@ -85,12 +63,15 @@ class VolPathIntegrator {
   /// length to time (0 on the camera segment in unwarp mode).
   void estimate_segment(const Medium& med, int m, const Ray& ray, double s_surf, const RGB& beta, double t,
                         double t_factor, Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
-  /// Optical depth and optical path length of [0, s] along `ray` inside medium m.
-  void segment_integrals(int m, const Ray& ray, double s, double& tau, double& opl) const;
   void deposit(double t_ps, double sigma_ps, const RGB& value, PixelAccumulator& acc,
                PathStats& stats) const;
+  /// Next-event estimation at a surface vertex with a non-delta BSDF (local frame z = ng).
+  void estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame, const Vec3& wo,
+                               bool wo_outside, const RGB& beta, double t, Rng& rng, PixelAccumulator& acc,
+                               PathStats& stats) const;
 
   const Scene& scene_;
+  MediumTracker tracker_;
   TemporalFilter filter_;
   int max_depth_;
   bool unwarp_;

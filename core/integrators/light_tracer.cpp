@@ -1,0 +1,67 @@
+#include "core/integrators/light_tracer.h"
+
+#include <cmath>
+
+#include "media/phase_hg.h"
+
+namespace femto {
+
+LightTracer::LightTracer(const Scene& scene, int max_depth, double t_cut_ps)
+    : scene_(scene),
+      tracker_(scene),
+      max_depth_(max_depth),
+      t_cut_(t_cut_ps),
+      unwarp_(scene.desc().time_mode == TimeMode::Unwarp) {}
+
+void LightTracer::splat(const Vec3& x, int m, const Vec3& w, double dist, const RGB& value, double t_ps,
+                        double sigma_ps, double fx, double fy, std::vector<Splat>& out, PathStats& stats) const {
+  if (value.is_black()) return;
+  double Tr, dt;
+  if (!tracker_.connect(x, m, w, dist, Tr, dt, stats)) return;
+  const RGB v = value * Tr;
+  const double t = unwarp_ ? t_ps : t_ps + dt;
+  if (!v.is_finite() || !std::isfinite(t)) {
+    ++stats.nonfinite_dropped;
+    return;
+  }
+  const Camera& cam = scene_.camera();
+  const auto px = static_cast<uint32_t>(std::min(static_cast<int>(fx), cam.width() - 1));
+  const auto py = static_cast<uint32_t>(std::min(static_cast<int>(fy), cam.height() - 1));
+  out.push_back({py * static_cast<uint32_t>(cam.width()) + px, t, sigma_ps, v});
+}
+
+void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) const {
+  const Camera& cam = scene_.camera();
+  const double eps = scene_.ray_epsilon();
+  walk_light_path(scene_, tracker_, rng, max_depth_, t_cut_, stats, [&](const LightVertex& v) {
+    double fx, fy, dist, W;
+    Vec3 w;
+    if (!cam.connect_to(v.p, fx, fy, w, dist, W)) return true;
+    switch (v.kind) {
+      case LightVertex::Kind::Emitter: {
+        const double cos_e = dot(v.n, w);
+        if (cos_e > 0) splat(v.p + v.n * eps, v.medium, w, dist, v.beta * (cos_e * W), v.t_ps, v.sigma_ps, fx, fy, out, stats);
+        return true;
+      }
+      case LightVertex::Kind::Medium:
+        splat(v.p, v.medium, w, dist, v.beta * (hg_eval(dot(v.d, w), v.g) * W), v.t_ps, v.sigma_ps, fx, fy, out,
+              stats);
+        return !v.connection_only;
+      case LightVertex::Kind::Surface: {
+        if (v.bsdf->is_delta()) return true;
+        const Vec3 wi = v.frame->to_local(w);
+        const bool out_side = wi.z > 0;
+        const RGB f = v.bsdf->f(v.wo, wi, TransportMode::Importance);
+        if (f.is_black()) return true;
+        const Vec3& ng = v.hit->ng;
+        const int m = out_side ? scene_.outside_medium() : scene_.inside_medium(v.hit->shape);
+        splat(v.p + ng * (out_side ? eps : -eps), m, w, dist - eps, v.beta * f * (std::abs(wi.z) * W), v.t_ps,
+              v.sigma_ps, fx, fy, out, stats);
+        return true;
+      }
+    }
+    return true;
+  });
+}
+
+}  // namespace femto

@@ -1,0 +1,41 @@
+#pragma once
+// Transient light tracing: light sub-paths (core/transport/light_walk.h) whose every non-delta
+// vertex is connected to the sensor and splatted into the pixel it projects to, at the path's
+// time plus the connection's (camera time) or without it (unwarp time). Emitting surfaces are
+// connected too; delta lights seen directly are not (as for camera paths, they cover no pixel
+// area). Specular surfaces seen by the camera need camera paths.
+#include <cstdint>
+#include <vector>
+
+#include "core/scene.h"
+#include "core/transport/light_walk.h"
+
+namespace femto {
+
+/// One contribution of a light path to one pixel.
+struct Splat {
+  uint32_t pixel = 0;   ///< y * width + x
+  double t_ps = 0;
+  double sigma_ps = 0;  ///< pulse std
+  RGB value;            ///< mean radiance added to the pixel times the number of light paths
+};
+
+class LightTracer {
+ public:
+  LightTracer(const Scene& scene, int max_depth, double t_cut_ps);
+  /// Traces one light path and appends its sensor splats to `out`.
+  void trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) const;
+
+ private:
+  /// Splat of the connection x -> sensor from medium m leaving along a known side (x already offset).
+  void splat(const Vec3& x, int m, const Vec3& w, double dist, const RGB& value, double t_ps, double sigma_ps,
+             double fx, double fy, std::vector<Splat>& out, PathStats& stats) const;
+
+  const Scene& scene_;
+  MediumTracker tracker_;
+  int max_depth_;
+  double t_cut_;
+  bool unwarp_;
+};
+
+}  // namespace femto

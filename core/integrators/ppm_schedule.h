@@ -1,0 +1,33 @@
+#pragma once
+// Spatial radius and temporal bandwidth of transient progressive photon mapping, pass by pass
+// (seed 000 eq. 10, Supp. C): the kernel volume R^2 T shrinks by (j + alpha) / (j + 1) per pass,
+// R^2 taking the power beta_R = 1 - beta_T and T the power beta_T:
+//   R_{j+1}^2 = R_j^2 ((j + alpha) / (j + 1))^beta_R,   T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_T.
+// Bias ~ R^2 + T^2 ~ n^{-(1-alpha) beta_R} + n^{-2 (1-alpha) beta_T} balances at beta_T = 1/3;
+// variance ~ 1 / (n R^2 T) ~ n^{-alpha}; the mean squared error then falls fastest, as n^{-4/7},
+// at alpha = 4/7.
+#include <cmath>
+
+namespace femto {
+
+class PpmSchedule {
+ public:
+  PpmSchedule(double radius_1, double bandwidth_1, double alpha, double beta_t)
+      : r2_(radius_1 * radius_1), T_(bandwidth_1), alpha_(alpha), beta_t_(beta_t) {}
+
+  int pass() const { return j_; }  ///< current pass, from 1
+  double radius() const { return std::sqrt(r2_); }
+  double bandwidth() const { return T_; }
+  void advance() {
+    const double ratio = (j_ + alpha_) / (j_ + 1.0);
+    r2_ *= std::pow(ratio, 1.0 - beta_t_);
+    T_ *= std::pow(ratio, beta_t_);
+    ++j_;
+  }
+
+ private:
+  int j_ = 1;
+  double r2_, T_, alpha_, beta_t_;
+};
+
+}  // namespace femto

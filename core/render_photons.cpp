@@ -1,0 +1,106 @@
+// femto render --integrator photons: camera paths plus transient progressive photon mapping.
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "core/integrators/photon_map.h"
+#include "core/integrators/ppm_schedule.h"
+#include "core/progress.h"
+#include "core/render.h"
+
+namespace femto {
+
+namespace {
+constexpr int kTile = 16;
+}
+
+RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  const Camera& camera = scene.camera();
+  const int W = camera.width(), H = camera.height();
+  const TimeAxis axis = scene.desc().time;
+  RenderResult result{TransientFilm(W, H, axis), PathStats{}, 0.0, 0, {}, {}, 0};
+  const TemporalFilter filter(axis, TemporalFilter::Kind::Histogram);
+  const VolPathIntegrator integrator(scene, filter, opt.max_depth);
+  const PhotonDesc& pd = opt.photons;
+  const double R1 = pd.radius > 0 ? pd.radius : default_photon_radius(scene);
+  const double T1 = pd.bandwidth_ps > 0 ? pd.bandwidth_ps : default_photon_bandwidth(scene.desc());
+  PpmSchedule schedule(R1, T1, pd.alpha, pd.beta_t);
+  // Photon times include the emission offset: the window end plus the widest pulse spread.
+  const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
+
+  const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
+  const size_t stride = static_cast<size_t>(axis.bins) * 3;
+  std::vector<double> bins(pixels * stride, 0.0);
+  std::vector<RGB> before(pixels), after(pixels);
+  const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
+  const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
+  result.threads = threads;
+  RenderResult::PhotonReport& rep = result.photons;
+  rep.passes = opt.spp;
+  rep.per_pass = pd.per_pass;
+  rep.radius_first = R1;
+  rep.bandwidth_first_ps = T1;
+
+  Progress progress(static_cast<uint64_t>(opt.spp), "photon passes", opt.quiet);
+  tbb::enumerable_thread_specific<PixelAccumulator> accumulators;
+  tbb::enumerable_thread_specific<PathStats> stats;
+  PathStats photon_stats;
+  PhotonGrid grid;
+  tbb::task_arena arena(threads);
+  arena.execute([&] {
+    for (int pass = 0; pass < opt.spp; ++pass) {
+      std::vector<Photon> photons =
+          trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth, photon_t_cut, photon_stats);
+      rep.max_stored_per_pass = std::max<uint64_t>(rep.max_stored_per_pass, photons.size());
+      grid.build(std::move(photons), schedule.radius());
+      rep.peak_photon_bytes = std::max(rep.peak_photon_bytes, grid.memory_bytes());
+      PhotonGather gather;
+      gather.grid = &grid;
+      gather.radius = schedule.radius();
+      gather.bandwidth_ps = schedule.bandwidth();
+      gather.inv_emitted = 1.0 / static_cast<double>(pd.per_pass);
+      gather.kernel = TemporalFilter(axis, TemporalFilter::Kind::Kernel, pd.kernel);
+      rep.radius_last = gather.radius;
+      rep.bandwidth_last_ps = gather.bandwidth_ps;
+      // One camera sample per pixel, the same stream as sample `pass` of a path-only render.
+      tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
+        PixelAccumulator& acc = accumulators.local();
+        PathStats& st = stats.local();
+        for (int tile = r.begin(); tile != r.end(); ++tile) {
+          const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+          const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
+          for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+              const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
+              acc.reset(axis.bins);
+              Rng rng = Rng::for_sample(opt.seed, p, static_cast<uint64_t>(pass));
+              const double fx = x + rng.uniform(), fy = y + rng.uniform();
+              integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, &gather);
+              double* dst = bins.data() + p * stride;
+              for (size_t i = 0; i < stride; ++i) dst[i] += acc.bins[i];
+              before[p] += acc.before;
+              after[p] += acc.after;
+            }
+        }
+      });
+      schedule.advance();
+      progress.add(1);
+    }
+  });
+  progress.finish();
+  for (const PathStats& s : stats) result.stats += s;
+  result.stats += photon_stats;
+  for (size_t p = 0; p < pixels; ++p)
+    result.film.set_pixel(static_cast<int>(p % static_cast<size_t>(W)), static_cast<int>(p / static_cast<size_t>(W)),
+                          bins.data() + p * stride, before[p], after[p], opt.spp);
+  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace femto
