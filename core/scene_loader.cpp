@@ -743,10 +743,15 @@ class Loader {
 
   MaterialDesc material(const Json& v, const std::string& p) const {
     const Json& o = object(v, p);
-    const Keys types = {"diffuse", "mirror", "dielectric"};
-    const Keys specific = {"albedo", "reflectance", "eta"};
+    const Keys types = {"diffuse", "mirror", "dielectric", "rough_dielectric", "rough_conductor"};
+    const Keys specific = {"albedo", "reflectance", "eta", "roughness"};
     const std::string type = type_of(o, p, types, join({"type"}, specific));
     MaterialDesc m;
+    // GGX alpha: 0 would be a smooth surface (use "dielectric" or "mirror"), above 1 is unphysical.
+    const auto roughness = [&] {
+      if (const Json* r = find(o, "roughness"))
+        m.roughness = number(*r, at(p, "roughness"), within(0, 1, true, false));
+    };
     if (type == "diffuse") {
       check_keys(o, p, {"type", "albedo"}, "a diffuse material", specific);
       m.type = MaterialDesc::Type::Diffuse;
@@ -756,10 +761,20 @@ class Loader {
       m.type = MaterialDesc::Type::Mirror;
       if (const Json* r = find(o, "reflectance"))
         m.reflectance = rgb(*r, at(p, "reflectance"), 1.0);
+    } else if (type == "rough_conductor") {
+      check_keys(o, p, {"type", "reflectance", "roughness"}, "a rough conductor material",
+                 specific);
+      m.type = MaterialDesc::Type::RoughConductor;
+      if (const Json* r = find(o, "reflectance"))
+        m.reflectance = rgb(*r, at(p, "reflectance"), 1.0);
+      roughness();
     } else {
-      check_keys(o, p, {"type", "eta"}, "a dielectric material", specific);
-      m.type = MaterialDesc::Type::Dielectric;
+      const bool rough = type == "rough_dielectric";
+      check_keys(o, p, rough ? Keys{"type", "eta", "roughness"} : Keys{"type", "eta"},
+                 rough ? "a rough dielectric material" : "a dielectric material", specific);
+      m.type = rough ? MaterialDesc::Type::RoughDielectric : MaterialDesc::Type::Dielectric;
       if (const Json* e = find(o, "eta")) m.eta = number(*e, at(p, "eta"), at_least(1));
+      if (rough) roughness();
     }
     return m;
   }
@@ -852,12 +867,15 @@ class Loader {
     }
 
     if (const Json* m = find(o, "material")) s.material = material(*m, at(p, "material"));
-    const bool opaque = s.material.type == MaterialDesc::Type::Diffuse ||
-                        s.material.type == MaterialDesc::Type::Mirror;
-    if (s.type == ShapeDesc::Type::Quad && s.material.type == MaterialDesc::Type::Dielectric)
+    // Diffuse, mirror and rough conductor surfaces let no light in; dielectrics (smooth or rough)
+    // bound a region of their own index.
+    const bool opaque =
+        s.material.type != MaterialDesc::Type::None && !s.material.is_transmissive();
+    const std::string dielectric =
+        s.material.type == MaterialDesc::Type::RoughDielectric ? "rough dielectric" : "dielectric";
+    if (s.type == ShapeDesc::Type::Quad && s.material.is_transmissive())
       fail(at(p, "material"),
-           "a dielectric needs a closed shape (sphere, box or mesh); a quad has "
-           "no inside",
+           "a " + dielectric + " needs a closed shape (sphere, box or mesh); a quad has no inside",
            o.at("material"));
     if (const Json* m = find(o, "medium")) {
       const std::string mp = at(p, "medium");
@@ -868,12 +886,11 @@ class Loader {
              *m);
       s.interior_medium = medium_ref(*m, mp, scene);
       const MediumDesc& md = scene.media[static_cast<std::size_t>(s.interior_medium)];
-      if (s.material.type == MaterialDesc::Type::Dielectric &&
-          std::abs(md.medium.eta - s.material.eta) > 1e-12) {
+      if (s.material.is_transmissive() && std::abs(md.medium.eta - s.material.eta) > 1e-12) {
         const Json& mat = o.at("material");
         const Json* e = find(mat, "eta");
         fail(e ? at(at(p, "material"), "eta") : at(p, "material"),
-             "dielectric eta " + fmt(s.material.eta) + (e ? "" : " (the default)") +
+             dielectric + " eta " + fmt(s.material.eta) + (e ? "" : " (the default)") +
                  " differs from eta " + fmt(md.medium.eta) + " of its interior medium '" + md.name +
                  "'; they must be equal",
              e ? *e : mat);
@@ -892,13 +909,12 @@ class Loader {
 
     if (const Json* t = find(o, "transform")) apply_transform(transform(*t, at(p, "transform")), s);
     if (s.type == ShapeDesc::Type::Mesh &&
-        (s.interior_medium >= 0 || s.material.type == MaterialDesc::Type::Dielectric)) {
+        (s.interior_medium >= 0 || s.material.is_transmissive())) {
       const std::string problem = closed_mesh_problem(s.vertices, s.triangles);
       if (!problem.empty())
         fail(at(p, "file"),
-             "a mesh with a medium or dielectric must be closed and outward-facing, "
-             "but " +
-                 problem,
+             "a mesh with a medium or a " + dielectric +
+                 " material must be closed and outward-facing, but " + problem,
              o.at("file"));
     }
     return s;

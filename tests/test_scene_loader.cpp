@@ -559,6 +559,91 @@ TEST_CASE("scene loader: mesh files", "[scene_loader]") {
   CHECK_THAT(error_of(j), Contains("/shapes/3/file") && Contains("inward"));
 }
 
+// Catches: rough-material keys read into the wrong field or with undocumented defaults,
+// out-of-range roughness, eta or reflectance accepted, and rough dielectrics or conductors
+// escaping the shape rules of their smooth counterparts.
+TEST_CASE("scene loader: rough dielectric and rough conductor materials", "[scene_loader]") {
+  Json j = base_scene();
+  j["shapes"][0]["material"] = {{"type", "rough_dielectric"}, {"eta", 1.33}, {"roughness", 0.3}};
+  j["shapes"][1]["material"] = {
+      {"type", "rough_conductor"}, {"reflectance", {0.9, 0.6, 0.3}}, {"roughness", 1}};
+  j["shapes"][2]["material"] = {{"type", "rough_dielectric"}};
+  j["shapes"][3]["material"] = {{"type", "rough_dielectric"}, {"eta", 1.33}};  // the fog's eta
+  j["shapes"][4]["material"] = {{"type", "rough_conductor"}};
+  SceneDesc s = load(j);
+  const femto::MaterialDesc& rd = s.shapes[0].material;
+  CHECK(rd.type == femto::MaterialDesc::Type::RoughDielectric);
+  CHECK(rd.eta == 1.33);
+  CHECK(rd.roughness == 0.3);
+  const femto::MaterialDesc& rc = s.shapes[1].material;
+  CHECK(rc.type == femto::MaterialDesc::Type::RoughConductor);
+  CHECK(rc.reflectance.g == 0.6);
+  CHECK(rc.roughness == 1.0);
+  CHECK(s.shapes[2].material.eta == 1.5);  // defaults
+  CHECK(s.shapes[2].material.roughness == 0.1);
+  CHECK(s.shapes[2].interior_medium == -1);
+  CHECK(s.shapes[4].material.reflectance.b == 1.0);
+  CHECK(s.shapes[4].material.roughness == 0.1);
+
+  // One error per key.
+  for (const double r : {0.0, 1.5, -0.1}) {
+    Json k = j;
+    k["shapes"][0]["material"]["roughness"] = r;
+    CHECK_THAT(error_of(k), Contains("/shapes/0/material/roughness: must be in (0, 1] (got " +
+                                     Json(r).dump() + ")"));
+  }
+  Json k = j;
+  k["shapes"][1]["material"]["roughness"] = "smooth";
+  CHECK_THAT(error_of(k), Contains("/shapes/1/material/roughness: expected a number"));
+  k = j;
+  k["shapes"][2]["material"]["eta"] = 0.9;
+  CHECK_THAT(error_of(k), Contains("/shapes/2/material/eta: must be >= 1 (got 0.9)"));
+  k = j;
+  k["shapes"][1]["material"]["reflectance"] = {0.5, 1.2, 0.5};
+  CHECK_THAT(error_of(k),
+             Contains("/shapes/1/material/reflectance/1: must be in [0, 1] (got 1.2)"));
+  k = j;
+  k["shapes"][1]["material"]["eta"] = 1.5;
+  CHECK_THAT(error_of(k), Contains("/shapes/1/material/eta: key 'eta' does not apply to a rough "
+                                   "conductor material"));
+  k = j;
+  k["shapes"][0]["material"]["reflectance"] = 1;
+  CHECK_THAT(error_of(k), Contains("/shapes/0/material/reflectance: key 'reflectance' does not "
+                                   "apply to a rough dielectric material"));
+  k = j;
+  k["shapes"][1]["material"] = {{"type", "mirror"}, {"roughness", 0.2}};
+  CHECK_THAT(error_of(k), Contains("/shapes/1/material/roughness: key 'roughness' does not apply "
+                                   "to a mirror material"));
+  k = j;
+  k["shapes"][0]["material"]["type"] = "rough_dielectirc";
+  CHECK_THAT(error_of(k), Contains("/shapes/0/material/type") &&
+                              Contains("did you mean 'rough_dielectric'"));
+
+  // Shape rules: a rough dielectric behaves like a dielectric, a rough conductor like a mirror.
+  k = j;
+  k["shapes"][1]["material"] = {{"type", "rough_dielectric"}};
+  CHECK_THAT(error_of(k), Contains("/shapes/1/material: a rough dielectric needs a closed shape"));
+  k = j;
+  k["shapes"][0]["material"]["eta"] = 1.5;  // interior medium has 1.33
+  CHECK_THAT(error_of(k), Contains("/shapes/0/material/eta: rough dielectric eta 1.5 differs") &&
+                              Contains("'fog'"));
+  k = j;
+  k["shapes"][3]["material"].erase("eta");
+  CHECK_THAT(error_of(k), Contains("/shapes/3/material: rough dielectric eta 1.5 (the default)"));
+  k = j;
+  k["shapes"][2]["medium"] = "fog";  // rough conductor box
+  k["shapes"][2]["material"] = {{"type", "rough_conductor"}};
+  CHECK_THAT(error_of(k), Contains("/shapes/2/medium") && Contains("opaque"));
+  write_file("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n");
+  k = j;
+  k["shapes"][3]["file"] = "open.obj";
+  k["shapes"][3].erase("medium");
+  CHECK_THAT(error_of(k), Contains("/shapes/3/file") && Contains("rough dielectric") &&
+                              Contains("not closed"));
+  k["shapes"][3]["material"] = {{"type", "rough_conductor"}};  // opaque: may be open
+  CHECK(load(k).shapes[3].material.type == femto::MaterialDesc::Type::RoughConductor);
+}
+
 TEST_CASE("scene loader: JSON syntax errors give line and column", "[scene_loader]") {
   CHECK_THAT(error_of_text("{\n  \"camera\": {\n    \"fov\": 30,,\n  }\n}"),
              Contains("test.json: line 3, column 15: ") && Contains("syntax error"));
