@@ -41,7 +41,7 @@ Scene::Scene(SceneDesc desc)
     if (sh.material.type == MaterialDesc::Type::None) has_null_boundaries_ = true;
     if (sh.interior_medium >= 0) {
       inside_[i] = sh.interior_medium;
-    } else if (sh.material.type == MaterialDesc::Type::Dielectric) {
+    } else if (sh.material.is_transmissive()) {
       Medium clear;
       clear.homogeneous.eta = sh.material.eta;
       media_.push_back(clear);

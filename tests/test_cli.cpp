@@ -568,3 +568,104 @@ TEST_CASE("cli: unknown subcommand exits 2", "[cli]") {
   const RunResult none = run_femto({}, tmp.dir, tmp.dir / "logs_none");
   CHECK(none.code == 2);
 }
+
+// Catches: --integrator ignored, render.json not saying which integrator ran and why, the
+// automatic choice not picking photons for a delta light behind glass, or photon settings lost.
+TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
+  CliTempDir tmp;
+  json s = small_scene();
+  s["shapes"].push_back(json::parse(R"({ "type": "sphere", "center": [0, 0, 20], "radius": 10,
+                                          "material": { "type": "dielectric", "eta": 1.5 } })"));
+  write_text(tmp.dir / "glass.json", s.dump(2));
+  struct Case {
+    std::vector<std::string> flags;
+    std::string type, why_part;
+  };
+  const std::vector<Case> cases = {
+      {{}, "photons", "auto"},
+      {{"--integrator", "path"}, "path", "chosen"},
+      {{"--integrator", "light", "--light-paths", "20000"}, "light", "chosen"},
+      {{"--integrator", "photons", "--photons", "3000", "--photon-radius", "2", "--photon-bandwidth", "20"},
+       "photons", "chosen"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const fs::path out = tmp.dir / ("out" + std::to_string(i));
+    std::vector<std::string> args = {"render", (tmp.dir / "glass.json").string(), "--spp", "2", "--out", out.string(),
+                                     "--quiet", "--frames", "none", "--no-previews"};
+    args.insert(args.end(), cases[i].flags.begin(), cases[i].flags.end());
+    const RunResult r = run_femto(args, tmp.dir, tmp.dir / ("logs" + std::to_string(i)));
+    INFO(r.command << "\nstderr: " << r.err);
+    REQUIRE(r.code == 0);
+    const json info = json::parse(read_text(out / "render.json"));
+    const json& integ = info["settings"]["integrator"];
+    CHECK(integ["type"] == cases[i].type);
+    CHECK(contains(integ["why"].get<std::string>(), cases[i].why_part));
+    if (cases[i].type == "photons") {
+      CHECK(integ["passes"] == 2);
+      CHECK(integ["photons_per_pass"].get<int64_t>() == (cases[i].flags.empty() ? 200000 : 3000));
+      CHECK(integ["photon_memory_bytes_peak"].get<uint64_t>() > 0);
+      if (!cases[i].flags.empty()) {
+        CHECK(integ["radius_mm"]["first_pass"].get<double>() == 2.0);
+        CHECK(integ["bandwidth_ps"]["first_pass"].get<double>() == 20.0);
+        // Second pass: R^2 and T shrink by ((1 + alpha) / 2)^(beta) with alpha = 4/7.
+        const double ratio = (1.0 + 4.0 / 7.0) / 2.0;
+        CHECK(integ["radius_mm"]["last_pass"].get<double>() == Approx(2.0 * std::sqrt(std::pow(ratio, 2.0 / 3.0))));
+        CHECK(integ["bandwidth_ps"]["last_pass"].get<double>() == Approx(20.0 * std::pow(ratio, 1.0 / 3.0)));
+      }
+      CHECK(info["counters"]["light_paths"].get<uint64_t>() > 0);
+    }
+    if (cases[i].type == "light") CHECK(integ["light_paths"] == 20000);
+  }
+}
+
+// Catches: photon and light-path settings accepted where they mean nothing or with impossible
+// values, and an integrator that cannot handle the scene's film, each with a clear exit-2
+// message and nothing written.
+TEST_CASE("cli: bad integrator input exits 2 naming the key and value", "[cli]") {
+  CliTempDir tmp;
+  const json s = small_scene();
+  write_text(tmp.dir / "good.json", s.dump(2));
+  auto with = [&](const std::string& name, const std::function<void(json&)>& edit) {
+    json t = small_scene();
+    edit(t);
+    write_text(tmp.dir / name, t.dump(2));
+    return (tmp.dir / name).string();
+  };
+  const std::string good = (tmp.dir / "good.json").string();
+  const std::string out = (tmp.dir / "out").string();
+  struct Case {
+    std::vector<std::string> args;
+    std::vector<std::string> expect;
+  };
+  const std::vector<Case> cases = {
+      {{"render", good, "--integrator", "bidir"}, {"--integrator", "bidir"}},
+      {{"render", good, "--integrator", "photons", "--photons", "-5"}, {"--photons", "-5"}},
+      {{"render", good, "--integrator", "photons", "--photons", "0"}, {"--photons", "0"}},
+      {{"render", good, "--integrator", "photons", "--photon-radius", "0"}, {"--photon-radius", "0"}},
+      {{"render", good, "--integrator", "photons", "--photon-bandwidth", "-1"}, {"--photon-bandwidth", "-1"}},
+      {{"render", good, "--integrator", "path", "--photons", "1000"}, {"--photons", "photon mapping only"}},
+      {{"render", good, "--light-paths", "1000", "--integrator", "path"}, {"--light-paths"}},
+      {{"render", good, "--integrator", "light", "--reconstruction", "kernel"}, {"light", "kernel film"}},
+      {{"render", with("k1.json", [](json& t) { t["render"]["integrator"] = "photon"; })},
+       {"/render/integrator", "photon"}},
+      {{"render", with("k2.json", [](json& t) { t["render"]["photons"] = json{{"per_pass", -1}}; })},
+       {"/render/photons/per_pass", "-1"}},
+      {{"render", with("k3.json", [](json& t) { t["render"]["photons"] = json{{"radius", 0}}; })},
+       {"/render/photons/radius", "0"}},
+      {{"render", with("k4.json", [](json& t) { t["render"]["photons"] = json{{"alpha", 1.5}}; })},
+       {"/render/photons/alpha", "1.5"}},
+      {{"render", with("k5.json", [](json& t) { t["render"]["photons"] = json{{"radius_mm", 1}}; })},
+       {"/render/photons", "radius_mm"}},
+      {{"render", with("k6.json", [](json& t) { t["render"]["light_paths"] = 0; })}, {"/render/light_paths", "0"}},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    std::vector<std::string> args = cases[i].args;
+    args.insert(args.end(), {"--out", out, "--quiet"});
+    const RunResult r = run_femto(args, tmp.dir, tmp.dir / ("logs" + std::to_string(i)));
+    INFO(r.command << "\nstderr: " << r.err);
+    CHECK(r.code == 2);
+    CHECK(count_lines(r.err) == 1);
+    for (const auto& part : cases[i].expect) CHECK(contains(r.err, part));
+    CHECK_FALSE(fs::exists(out));
+  }
+}

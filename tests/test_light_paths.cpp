@@ -208,6 +208,36 @@ TEST_CASE("light tracing agrees with camera paths: a diffuse room with an area l
   require_agreement(compare(pt, lt), 20);
 }
 
+// Catches: light paths and camera paths scattering off rough surfaces differently: the
+// importance-mode BSDF (no 1/eta^2 on refraction), rough refraction seen by the camera through
+// connections from the exit vertex, and the two-sided rough conductor.
+TEST_CASE("light tracing agrees with camera paths through rough glass and off rough metal", "[light-paths]") {
+  SceneDesc d;
+  d.source = "rough";
+  d.camera = perspective({0, 30, 120}, {0, 20, 0}, 45, 16, 12);
+  d.time = axis_of(300, 100, 8);
+  d.shapes.push_back(quad({-60, 0, 60}, {120, 0, 0}, {0, 0, -120}, diffuse(0.7)));
+  MaterialDesc metal;
+  metal.type = MaterialDesc::Type::RoughConductor;
+  metal.reflectance = RGB(0.9, 0.7, 0.4);
+  metal.roughness = 0.3;
+  d.shapes.push_back(quad({-60, 0, -40}, {120, 0, 0}, {0, 70, -10}, metal));
+  MaterialDesc frosted;
+  frosted.type = MaterialDesc::Type::RoughDielectric;
+  frosted.eta = 1.5;
+  frosted.roughness = 0.3;
+  d.shapes.push_back(sphere({-5, 18, 10}, 14, frosted));
+  ShapeDesc lamp = quad({-20, 70, -20}, {40, 0, 0}, {0, 0, 40}, diffuse(0.0));  // faces down
+  lamp.emissive = true;
+  lamp.emission = RGB(3.0);
+  d.shapes.push_back(lamp);
+  d.lights.push_back(point_light({25, 40, 20}, 400.0));
+  const Scene scene(d);
+  const auto pt = cells(batches(scene, IntegratorKind::Path, 128, 24, 1400), 4, 2);
+  const auto lt = cells(batches(scene, IntegratorKind::Light, 80000, 24, 1500), 4, 2);
+  require_agreement(compare(pt, lt), 15);
+}
+
 // Catches: light paths that do not follow the per-voxel index (time from the wrong eta, or the
 // voxel medium's albedo and extinction ignored on the light side).
 TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-voxel eta", "[light-paths]") {

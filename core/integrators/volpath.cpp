@@ -87,8 +87,11 @@ void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceH
   if (f.is_black()) return;
   const Vec3 x = wi_outside == wo_outside ? x_wo : hit.p + hit.ng * (wi_outside ? eps : -eps);
   const int m = wi_outside ? scene_.outside_medium() : scene_.inside_medium(hit.shape);
+  // From the other side the light is nearer by the offset's projection (else the occlusion
+  // test would reach the light's own surface).
+  const double dist = ls.dist - dot(x - x_wo, ls.wi);
   double Tr, dt;
-  if (!tracker_.connect(x, m, ls.wi, ls.dist, Tr, dt, stats)) return;
+  if (!tracker_.connect(x, m, ls.wi, dist, Tr, dt, stats)) return;
   const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, bsdf.pdf(wo, wi));
   const Light& L = lights.light(li);
   deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(),
