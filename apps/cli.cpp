@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstdlib>
 #include <ctime>
 
@@ -39,7 +40,7 @@ std::string Args::value() {
 
 void Args::fail(const std::string& problem, const std::string& got) const {
   std::string msg = command_ + ": " + flag_ + ": " + problem;
-  if (!got.empty()) msg += " (got '" + got + "')";
+  if (!got.empty()) msg += " (got '" + clip(got, 200) + "')";
   throw InputError(msg);
 }
 
@@ -130,7 +131,11 @@ uint64_t Args::size_value() {
   else if (unit == "G" || unit == "GB" || unit == "GIB") mult = 1024.0 * 1024 * 1024;
   else if (unit == "T" || unit == "TB" || unit == "TIB") mult = 1024.0 * 1024 * 1024 * 1024;
   else fail("unknown size unit (use K, M, G or T)", v);
-  return static_cast<uint64_t>(x * mult);
+  const double bytes = x * mult;
+  if (bytes < 1) fail("must be at least 1 byte", v);
+  // A double at or above 2^64 has no uint64 value (the cast would be undefined): no limit.
+  if (bytes >= 18446744073709551616.0) return UINT64_MAX;
+  return static_cast<uint64_t>(bytes);
 }
 
 std::string format_bytes(uint64_t bytes) {

@@ -29,7 +29,7 @@ class Args {
   Vec3 xyz_value(bool nonzero = false);
   /// A whole count in [lo, hi], also written like 1e6.
   uint64_t count_value(double lo, double hi);
-  /// Sizes like 512M, 4G, 1.5GiB or plain bytes.
+  /// Sizes like 512M, 4G, 1.5GiB or plain bytes; 2^64 bytes or more means no limit.
   uint64_t size_value();
   /// Throws InputError "<command>: <flag>: <problem> (got '<value>')".
   [[noreturn]] void fail(const std::string& problem, const std::string& got) const;

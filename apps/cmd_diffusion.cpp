@@ -1,7 +1,9 @@
 // `femto diffusion`: Monte Carlo of a pulsed isotropic point source in an infinite homogeneous
 // medium, compared with diffusion theory, Paasschens' solution and the exact <r^2>(t); reports
 // when the wavefront becomes Gaussian (docs/diffusion.md).
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -58,7 +60,10 @@ const char* kDiffusionHelp =
     "  --plot-times LIST  comma-separated times (ps) for fluence.png, 1 to 6 of them\n"
     "                     (default 1, 3, 10, 30 mean free times inside the window)\n"
     "Run:\n"
-    "  --photons N        photons, 2..1e12, e.g. 1e6 (default 1e6)\n"
+    "  --photons N        photons, 2..1e12, e.g. 1e6 (default 1e6); the run time estimated after\n"
+    "                     the first batches is printed\n"
+    "  --max-seconds S    stop after about S seconds and write the photons traced so far;\n"
+    "                     Ctrl-C does the same (exit code 130), a second Ctrl-C aborts\n"
     "  --seed S           random seed, integer >= 0; the same seed gives bit-identical output for\n"
     "                     any thread count (default 1)\n"
     "  --threads N        worker threads, 0 = all cores (default 0)\n"
@@ -70,7 +75,16 @@ const char* kDiffusionHelp =
     "fluence.png and distance.png (see docs/diffusion.md).\n";
 
 
-// A number from the current flag's value, with a message naming the flag and the value.
+// Ctrl-C ends the run after the current round of photons; the results so far are written.
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) {
+  g_interrupted.store(true);
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C aborts at once
+}
+
+// The smallest time bin and shell: their widths divide the tallies (a 1e-300 ps window would
+// give infinite densities).
+constexpr double kMinBinPs = 1e-9, kMinShellMm = 1e-9;
 
 int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& command_line) {
   std::vector<std::string> argv = argv_in;
@@ -144,6 +158,8 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
         args.fail("expected 1 to 6 times", plot_text);
     } else if (a == "--photons") {
       setup.photons = args.count_value(2, 1e12);
+    } else if (a == "--max-seconds") {
+      setup.max_seconds = args.number_in(0, 1e9, true, false, "in (0, 1e9] s");
     } else if (a == "--seed") {
       setup.seed = args.uint_value();
     } else if (a == "--threads") {
@@ -172,10 +188,12 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
       mi = -1;
       for (size_t i = 0; i < scene.media.size(); ++i)
         if (scene.media[i].name == medium_name) mi = static_cast<int>(i);
-      if (mi < 0) throw InputError("femto diffusion: --medium: no medium named '" + medium_name + "' in " + scene_path);
+      if (mi < 0)
+        throw InputError("femto diffusion: --medium: no medium named '" + clip(medium_name) +
+                         "' in " + clip(scene_path, 200));
     }
     if (mi < 0)
-      throw InputError("femto diffusion: --medium: " + scene_path + " has no \"medium\" around everything; name one");
+      throw InputError("femto diffusion: --medium: " + clip(scene_path, 200) + " has no \"medium\" around everything; name one");
     const MediumDesc& md = scene.media[static_cast<size_t>(mi)];
     source = {{"kind", "scene medium"}, {"scene", scene_path}, {"medium", md.name},
               {"position_mm", {at->x, at->y, at->z}}, {"shapes", "ignored: the medium fills space"}};
@@ -212,6 +230,13 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
   }
   if (!(*t_end > t_start)) fail("--t-end", "must be greater than --t-start", *t_end);
   if (!r_max) r_max = sc.v * *t_end;
+  if ((*t_end - t_start) / t_bins < kMinBinPs)
+    fail("--t-end", "time bins of (--t-end - --t-start) / --t-bins must be at least 1e-9 ps wide",
+         *t_end);
+  if (*r_max / r_bins < kMinShellMm)
+    fail("--r-max", "shells of --r-max / --r-bins (default r-max: (c / eta) t_end) must be at "
+                    "least 1e-9 mm thick",
+         *r_max);
   if (static_cast<double>(t_bins) * r_bins > 2e6)
     fail("--r-bins", "shells x time bins must be at most 2e6 (lower --r-bins or --t-bins)", r_bins);
   for (double t : plot_times)
@@ -240,8 +265,13 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
                  static_cast<unsigned long long>(setup.photons), t_bins, *t_end, r_bins, *r_max,
                  setup.medium.sigma_s * sc.v * *t_end);
 
+  g_interrupted.store(false);
+  setup.stop = &g_interrupted;
+  const auto previous = std::signal(SIGINT, on_interrupt);
   const diffusion::DiffusionResult result =
       transport ? diffusion::simulate(setup, *transport) : diffusion::simulate(setup);
+  std::signal(SIGINT, previous);
+  const bool interrupted = result.stopped_early && g_interrupted.load();
   const diffusion::Analysis analysis = diffusion::analyse(setup, result, threshold);
   diffusion::ReportOptions opt;
   opt.dir = out_dir;
@@ -250,7 +280,12 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
              {"femto_build", FEMTO_GIT_DESCRIBE},
              {"command", command_line},
              {"date_utc", cli::utc_now()},
-             {"source", source}};
+             {"source", source},
+             {"photons_requested", setup.photons},
+             {"photons_traced", result.photons},
+             {"stopped_early", !result.stopped_early ? nlohmann::json(nullptr)
+                               : interrupted         ? nlohmann::json("interrupted (Ctrl-C)")
+                                                     : nlohmann::json("--max-seconds")}};
   const std::vector<std::string> files = diffusion::write_report(setup, result, analysis, opt);
 
   if (!quiet) {
@@ -274,8 +309,13 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
     std::string list;
     for (const auto& f : files) list += (list.empty() ? "" : ", ") + f;
     std::fprintf(stderr, "femto diffusion: results in %s/ (%s)\n", out_dir.c_str(), list.c_str());
+    if (result.stopped_early)
+      std::fprintf(stderr, "femto diffusion: stopped early (%s): %llu of %llu photons traced\n",
+                   interrupted ? "interrupted" : "--max-seconds",
+                   static_cast<unsigned long long>(result.photons),
+                   static_cast<unsigned long long>(setup.photons));
   }
-  return 0;
+  return interrupted ? 130 : 0;
 }
 }  // namespace
 

@@ -58,10 +58,10 @@ std::string sampling(const MediumDesc& m) {
 
 void print_vdb(const VdbMediumDesc& d, const VolumeData& v) {
   const TransformDesc& t = d.transform;
-  std::printf("    file:            %s\n", d.file.c_str());
-  std::printf("    grids:           density '%s'%s%s\n", d.density_grid.c_str(),
-              d.albedo_grid.empty() ? "" : (", albedo '" + d.albedo_grid + "'").c_str(),
-              d.eta_grid.empty() ? "" : (", eta '" + d.eta_grid + "'").c_str());
+  std::printf("    file:            %s\n", clip(d.file, 200).c_str());
+  std::printf("    grids:           density '%s'%s%s\n", clip(d.density_grid).c_str(),
+              d.albedo_grid.empty() ? "" : (", albedo '" + clip(d.albedo_grid) + "'").c_str(),
+              d.eta_grid.empty() ? "" : (", eta '" + clip(d.eta_grid) + "'").c_str());
   std::printf("    interpolation:   %s\n",
               d.interpolation == VdbMediumDesc::Interpolation::Nearest ? "nearest" : "trilinear");
   std::printf("    transform:       scale %s, rotate %s deg, translate %s mm\n", vec(t.scale).c_str(),
@@ -71,10 +71,11 @@ void print_vdb(const VdbMediumDesc& d, const VolumeData& v) {
   std::printf("    voxel size:      %s mm\n",
               vec({v.voxel_size[0], v.voxel_size[1], v.voxel_size[2]}).c_str());
   const DenseGrid& g = v.density;
-  std::printf("    dense grid:      %d x %d x %d cells (%llu), VDB index box (%d, %d, %d) to (%d, %d, %d)\n",
+  // 64-bit: a box touching INT_MAX would overflow index_min + n - 1 in int.
+  const auto last = [&](int a, int n) { return static_cast<long long>(v.index_min[a]) + n - 1; };
+  std::printf("    dense grid:      %d x %d x %d cells (%llu), VDB index box (%d, %d, %d) to (%lld, %lld, %lld)\n",
               g.nx, g.ny, g.nz, static_cast<unsigned long long>(g.v.size()), v.index_min[0],
-              v.index_min[1], v.index_min[2], v.index_min[0] + g.nx - 1, v.index_min[1] + g.ny - 1,
-              v.index_min[2] + g.nz - 1);
+              v.index_min[1], v.index_min[2], last(0, g.nx), last(1, g.ny), last(2, g.nz));
   std::printf("    active voxels:   %llu (%.3g%% of the dense cells)\n",
               static_cast<unsigned long long>(v.active_voxels),
               100.0 * static_cast<double>(v.active_voxels) / static_cast<double>(g.v.size()));
@@ -117,7 +118,7 @@ int cmd_info(const std::vector<std::string>& argv, const std::string&) {
       volumes[i] = load_volume(s.media[i].vdb, s.source, medium_where(s.media[i].name));
 
   const CameraDesc& c = s.camera;
-  std::printf("scene: %s\n", s.source.c_str());
+  std::printf("scene: %s\n", clip(s.source, 200).c_str());
   if (c.type == CameraDesc::Type::Perspective)
     std::printf("camera: perspective, %d x %d pixels, fov %s deg, at %s looking at %s\n", c.width,
                 c.height, g6(c.fov_deg).c_str(), vec(c.position).c_str(), vec(c.look_at).c_str());
@@ -158,7 +159,7 @@ int cmd_info(const std::vector<std::string>& argv, const std::string&) {
 
   std::printf("media: %zu; around everything: %s\n", s.media.size(),
               s.global_medium < 0 ? "vacuum"
-                                  : ("'" + s.media[static_cast<size_t>(s.global_medium)].name + "'").c_str());
+                                  : ("'" + clip(s.media[static_cast<size_t>(s.global_medium)].name) + "'").c_str());
   for (size_t i = 0; i < s.media.size(); ++i) {
     const MediumDesc& m = s.media[i];
     int inside = 0;
@@ -167,7 +168,7 @@ int cmd_info(const std::vector<std::string>& argv, const std::string&) {
                             (inside ? std::string(static_cast<int>(i) == s.global_medium ? ", " : "") +
                                           "inside " + std::to_string(inside) + " shape(s)"
                                     : "") ;
-    std::printf("  '%s': %s%s\n", m.name.c_str(),
+    std::printf("  '%s': %s%s\n", clip(m.name).c_str(),
                 m.type == MediumDesc::Type::Vdb ? "vdb" : "homogeneous",
                 use.empty() ? " (unused)" : (" (" + use + ")").c_str());
     if (m.type == MediumDesc::Type::Homogeneous) {

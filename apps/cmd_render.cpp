@@ -2,10 +2,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
-#include <fstream>
+#include <filesystem>
 #include <optional>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "apps/cli.h"
 #include "apps/commands.h"
@@ -61,8 +60,9 @@ const char* kRenderHelp =
     "  --photon-radius MM photon mapping: initial gather radius R_1 (default 0.5% of the\n"
     "                     bounding-box diagonal of the scene)\n"
     "  --photon-bandwidth PS  photon mapping: initial temporal bandwidth T_1 (default 1 bin)\n"
-    "  --max-depth N      safety bound on scattering/bounce vertices per path; paths stopped by\n"
-    "                     it are counted in render.json (scene default: 1000)\n"
+    "  --max-depth N      scattering/bounce vertices per path: 1 = single scattering, 2 = up\n"
+    "                     to double, ...; left at its default (1000) it is a safety bound and\n"
+    "                     paths reaching it are reported as a warning (counted in render.json)\n"
     "  --out DIR          output folder, created if missing (default ./femto-out)\n"
     "  --frames MODE      per-bin EXR frames: files (frames/*.exr, default), multipart\n"
     "                     (one transient.exr with a part per bin) or none\n"
@@ -85,12 +85,15 @@ nlohmann::json scene_json(const std::string& text) {
   return j.is_discarded() ? nlohmann::json(text) : j;
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the scene file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+// Where max_depth came from: a chosen bound ends paths on purpose, the default is a safety bound.
+std::string max_depth_source(bool flag, const IntegratorDesc& d) {
+  return flag ? "--max-depth" : d.max_depth_set ? "scene" : "default";
+}
+
+std::string file_list(const std::vector<std::string>& files) {
+  std::string s;
+  for (const auto& f : files) s += (s.empty() ? "" : ", ") + f;
+  return s;
 }
 
 nlohmann::json reconstruction_json(const ReconstructionDesc& r, const RenderResult& result) {
@@ -282,8 +285,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     scene_text = default_scene_json();
     desc = load_scene_string(scene_text, "<default scene>", ".");
   } else {
-    scene_text = read_text(scene_path);
-    desc = load_scene_file(scene_path);
+    scene_text = read_scene_text(scene_path);  // read once, size-limited
+    desc = load_scene_string(scene_text, scene_path,
+                             std::filesystem::path(scene_path).parent_path().string());
   }
   for (MediumDesc& m : desc.media) {
     if (sampling) m.sampling = *sampling;
@@ -332,6 +336,11 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   const CameraDesc& cam = desc.camera;
   const TimeAxis axis = desc.time;
   const uint64_t film_bytes = TransientFilm::memory_bytes(cam.width, cam.height, axis.bins);
+  if (film_bytes > max_memory)
+    throw InputError("film needs " + cli::format_bytes(film_bytes) + " (" + std::to_string(cam.width) +
+                     " x " + std::to_string(cam.height) + " pixels x " + std::to_string(axis.bins) +
+                     " bins x RGB float32), more than --max-memory " + cli::format_bytes(max_memory) +
+                     ": lower the resolution or the number of bins, or raise --max-memory");
   // Light tracing and photons sum every pixel over the whole render in double precision, and a
   // photon pass may keep every photon it emits.
   const uint64_t pixel_bins = static_cast<uint64_t>(cam.width) * static_cast<uint64_t>(cam.height) *
@@ -343,19 +352,19 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                      cli::format_bytes(film_bytes) + ", integrator buffers " + cli::format_bytes(extra_bytes) +
                      "), more than --max-memory " + cli::format_bytes(max_memory) +
                      ": lower the resolution, the number of bins or photons per pass, or raise --max-memory");
-  if (film_bytes > max_memory)
-    throw InputError("film needs " + cli::format_bytes(film_bytes) + " (" + std::to_string(cam.width) +
-                     " x " + std::to_string(cam.height) + " pixels x " + std::to_string(axis.bins) +
-                     " bins x RGB float32), more than --max-memory " + cli::format_bytes(max_memory) +
-                     ": lower the resolution or the number of bins, or raise --max-memory");
+  // Volumes share --max-memory with the film; the renderer keeps a second copy of their grids.
+  const uint64_t left_for_volumes = max_memory > film_bytes + extra_bytes ? max_memory - film_bytes - extra_bytes : 0;
+  for (MediumDesc& m : desc.media) m.vdb.max_dense_bytes = left_for_volumes / 2;
   if (!quiet)
     std::fprintf(stderr, "femto: %s: %d x %d pixels, %d bins of %.4g ps from %.4g ps, %d spp; film memory %s\n",
                  desc.source.c_str(), cam.width, cam.height, axis.bins, axis.bin_width_ps, axis.t_start_ps,
                  opt.spp, cli::format_bytes(film_bytes).c_str());
 
   const Scene scene(std::move(desc));
-  const RenderResult result = render(scene, opt);
+  RenderResult result = render(scene, opt);
   const PathStats& st = result.stats;
+  const uint64_t film_nonfinite = result.film.zero_nonfinite();  // outputs stay finite
+  const std::string depth_source = max_depth_source(max_depth.has_value(), scene.desc().integrator);
 
   nlohmann::json info;
   info["femto_version"] = FEMTO_VERSION;
@@ -367,7 +376,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   info["settings"] = {{"spp", opt.spp},
                       {"seed", opt.seed},
                       {"threads", result.threads},
+                      {"threads_requested", threads},
                       {"max_depth", opt.max_depth},
+                      {"max_depth_source", depth_source},
                       {"integrator", integrator_json(kind, integrator_why, opt, result)},
                       {"reconstruction", reconstruction_json(scene.desc().reconstruction, result)},
                       {"russian_roulette", false}};
@@ -412,6 +423,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"null_boundary_crossings", st.null_crossings},
                       {"max_depth_terminations", st.max_depth_hits},
                       {"nonfinite_samples_dropped", st.nonfinite_dropped},
+                      {"nonfinite_film_values_zeroed", film_nonfinite},
                       {"light_paths", st.light_paths},
                       {"photons_stored", st.photons_stored},
                       {"photon_gathers", st.photon_gathers}};
@@ -422,19 +434,25 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                     {"after_window", rgb_json(result.film.total_after())},
                     {"note", "sums over pixels; after_window only counts contributions of paths "
                              "still alive (paths stop once they pass the window end)"}};
-  write_outputs(result.film, out, info, result.final_bandwidth_ps);
+  const std::vector<std::string> files =
+      write_outputs(result.film, out, info, result.final_bandwidth_ps);
   if (!quiet) {
     std::fprintf(stderr, "femto: %llu paths in %s (%.3g paths/s, %d threads)\n",
                  static_cast<unsigned long long>(st.paths), format_duration(result.wall_seconds).c_str(),
                  info["timing"]["paths_per_second"].get<double>(), result.threads);
-    if (st.max_depth_hits > 0)
-      std::fprintf(stderr, "femto: warning: %llu paths reached --max-depth %d (counted in render.json)\n",
+    if (st.max_depth_hits > 0 && depth_source == "default")
+      std::fprintf(stderr, "femto: warning: %llu paths reached the safety bound max_depth %d (counted in render.json)\n",
+                   static_cast<unsigned long long>(st.max_depth_hits), opt.max_depth);
+    else if (st.max_depth_hits > 0)
+      std::fprintf(stderr, "femto: %llu paths ended at the chosen max_depth %d\n",
                    static_cast<unsigned long long>(st.max_depth_hits), opt.max_depth);
     if (st.nonfinite_dropped > 0)
       std::fprintf(stderr, "femto: warning: %llu non-finite contributions dropped\n",
                    static_cast<unsigned long long>(st.nonfinite_dropped));
-    std::fprintf(stderr, "femto: results in %s/ (steady.png, frames.png, steady.exr, frames/, transient.npy, render.json)\n",
-                 out.dir.c_str());
+    if (film_nonfinite > 0)
+      std::fprintf(stderr, "femto: warning: %llu film values overflowed float32 and were set to 0\n",
+                   static_cast<unsigned long long>(film_nonfinite));
+    std::fprintf(stderr, "femto: results in %s/ (%s)\n", out.dir.c_str(), file_list(files).c_str());
   }
   return 0;
 }

@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::fprintf(stderr, "femto: unknown command '%s' (try femto --help)\n", name.c_str());
+  std::fprintf(stderr, "femto: unknown command '%s' (try femto --help)\n",
+               femto::clip(name).c_str());
   return 2;
 }

@@ -36,6 +36,21 @@ void TransientFilm::set_pixel(int x, int y, const double* bins, const RGB& befor
   }
 }
 
+static uint64_t zero_nonfinite_in(std::vector<float>& v) {
+  uint64_t n = 0;
+  for (float& x : v)
+    if (!std::isfinite(x)) {
+      x = 0.0f;
+      ++n;
+    }
+  return n;
+}
+
+uint64_t TransientFilm::zero_nonfinite() {
+  return zero_nonfinite_in(transient_) + zero_nonfinite_in(steady_) + zero_nonfinite_in(before_) +
+         zero_nonfinite_in(after_);
+}
+
 std::vector<float> TransientFilm::peak_time() const {
   const size_t pixels = static_cast<size_t>(width_) * static_cast<size_t>(height_);
   std::vector<float> out(pixels, std::numeric_limits<float>::quiet_NaN());

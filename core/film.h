@@ -24,6 +24,10 @@ class TransientFilm {
   int bins() const { return axis_.bins; }
   const TimeAxis& axis() const { return axis_; }
 
+  /// Sets every NaN or infinite value (transient, steady, before, after) to 0 and returns how many
+  /// there were: a finite contribution can still overflow float32, and outputs must stay finite.
+  uint64_t zero_nonfinite();
+
   /// Stores a finished pixel: `bins` holds T x 3 sums over samples, divided here by `spp`.
   void set_pixel(int x, int y, const double* bins, const RGB& before, const RGB& after, int spp);
 

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <string_view>
@@ -51,14 +52,19 @@ bool ignored_statement(std::string_view k) {
 
 void load_obj(const std::string& path, std::vector<Vec3>& vertices,
               std::vector<std::array<uint32_t, 3>>& triangles) {
+  constexpr std::uintmax_t kMaxObjBytes = 1ull << 30;  // docs/scene-format.md, Bounds
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(clip(path, 200) + ": cannot read mesh file (" + ec.message() + ")");
+  if (size > kMaxObjBytes) throw InputError(clip(path, 200) + ": mesh file is larger than the 1 GiB limit");
   std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open mesh file");
+  if (!in) throw InputError(clip(path, 200) + ": cannot open mesh file");
   vertices.clear();
   triangles.clear();
 
   std::size_t line_no = 0;
   auto fail = [&](const std::string& problem) -> void {
-    throw InputError(path + ":" + std::to_string(line_no) + ": " + problem);
+    throw InputError(clip(path, 200) + ":" + std::to_string(line_no) + ": " + problem);
   };
   // Positive indices may point forward, so they are range-checked once the whole file is read.
   long long max_index = 0;
@@ -82,7 +88,7 @@ void load_obj(const std::string& path, std::vector<Vec3>& vertices,
       Vec3 p;
       for (int a = 0; a < 3; ++a)
         if (!parse_double(tok[static_cast<std::size_t>(a) + 1], p[a]))
-          fail("bad number '" + std::string(tok[static_cast<std::size_t>(a) + 1]) + "'");
+          fail("bad number '" + clip(std::string(tok[static_cast<std::size_t>(a) + 1])) + "'");
       if (vertices.size() >= std::numeric_limits<uint32_t>::max()) fail("too many vertices");
       vertices.push_back(p);
     } else if (key == "f") {
@@ -104,7 +110,7 @@ void load_obj(const std::string& path, std::vector<Vec3>& vertices,
         if (ok && parts.size() == 2) ok = parse_int(parts[1], unused);
         if (ok && parts.size() == 3)
           ok = (parts[1].empty() || parse_int(parts[1], unused)) && parse_int(parts[2], unused);
-        if (!ok) fail("bad face vertex '" + std::string(corner) + "'");
+        if (!ok) fail("bad face vertex '" + clip(std::string(corner)) + "'");
         const long long n = static_cast<long long>(vertices.size());
         if (idx < 0) {
           if (-idx > n)
@@ -119,23 +125,23 @@ void load_obj(const std::string& path, std::vector<Vec3>& vertices,
           idx -= 1;
         }
         if (idx > static_cast<long long>(std::numeric_limits<uint32_t>::max()))
-          fail("face index " + std::string(corner) + " is too large");
+          fail("face index " + clip(std::string(corner)) + " is too large");
         poly.push_back(static_cast<uint32_t>(idx));
       }
       for (std::size_t k = 1; k + 1 < poly.size(); ++k)
         triangles.push_back({poly[0], poly[k], poly[k + 1]});
     } else if (!ignored_statement(key)) {
-      fail("unsupported OBJ statement '" + std::string(key) +
+      fail("unsupported OBJ statement '" + clip(std::string(key)) +
            "' (only polygonal meshes are supported)");
     }
   }
-  if (in.bad()) throw InputError(path + ": read error");
+  if (in.bad()) throw InputError(clip(path, 200) + ": read error");
   if (max_index > static_cast<long long>(vertices.size())) {
     line_no = max_index_line;
     fail("face index " + std::to_string(max_index) + " is out of range (the file has " +
          std::to_string(vertices.size()) + " vertices)");
   }
-  if (triangles.empty()) throw InputError(path + ": mesh has no faces");
+  if (triangles.empty()) throw InputError(clip(path, 200) + ": mesh has no faces");
 }
 
 }  // namespace femto

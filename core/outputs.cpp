@@ -23,7 +23,7 @@ std::string frame_file_name(const TimeAxis& axis, int t) {
   return buf;
 }
 
-void write_outputs(const TransientFilm& film, const OutputOptions& opt, nlohmann::json info,
+std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOptions& opt, nlohmann::json info,
                    const std::vector<float>& bandwidth_ps) {
   const fs::path dir(opt.dir);
   std::error_code ec;
@@ -109,6 +109,7 @@ void write_outputs(const TransientFilm& film, const OutputOptions& opt, nlohmann
   files.push_back("render.json");
   info["outputs"] = files;
   write_text_atomically(path_of("render.json"), info.dump(2) + "\n");
+  return files.get<std::vector<std::string>>();
 }
 
 }  // namespace femto

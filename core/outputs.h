@@ -21,10 +21,10 @@ struct OutputOptions {
 /// File name of frame t inside the output folder, e.g. "frames/frame_0007_12.500ps.exr".
 std::string frame_file_name(const TimeAxis& axis, int t);
 
-/// Writes all outputs; `render_json` gets an "outputs" entry listing the files written. A
-/// non-empty `bandwidth_ps` (H x W, the kernel film's last bandwidth per pixel) is written as
-/// kernel_bandwidth.exr.
-void write_outputs(const TransientFilm& film, const OutputOptions& options, nlohmann::json render_json,
+/// Writes all outputs; `render_json` gets an "outputs" entry listing the files written, which are
+/// also returned. A non-empty `bandwidth_ps` (H x W, the kernel film's last bandwidth per pixel)
+/// is written as kernel_bandwidth.exr.
+std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOptions& options, nlohmann::json render_json,
                    const std::vector<float>& bandwidth_ps = {});
 
 }  // namespace femto

@@ -98,7 +98,9 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
   const VolPathIntegrator integrator(scene, filter, opt.max_depth);
 
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
-  const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
+  // oneTBB never runs more threads than the hardware has, so that is what gets recorded.
+  const int hardware = tbb::info::default_concurrency();
+  const int threads = opt.threads > 0 ? std::min(opt.threads, hardware) : hardware;
   result.threads = threads;
   Progress progress(
       static_cast<uint64_t>(W) * static_cast<uint64_t>(H) * static_cast<uint64_t>(opt.spp),

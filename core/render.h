@@ -25,7 +25,7 @@ struct RenderResult {
   TransientFilm film;
   PathStats stats;
   double wall_seconds = 0;
-  int threads = 0;
+  int threads = 0;  ///< threads used: the requested count, at most the hardware's
   /// Kernel film: bandwidth (ps) of each pixel's last sample, (H, W); empty for the histogram.
   std::vector<float> final_bandwidth_ps;
   /// Photon mapping: what was used (radius and bandwidth at the first and last pass, mm and ps).

@@ -88,6 +88,7 @@ struct VdbMediumDesc {
   enum class Interpolation { Nearest, Trilinear };
   Interpolation interpolation = Interpolation::Nearest;
   TransformDesc transform;
+  uint64_t max_dense_bytes = 16ull << 30;  ///< memory allowed for the dense grids (--max-memory)
 };
 
 struct MediumDesc {
@@ -155,6 +156,7 @@ struct PhotonDesc {
 struct IntegratorDesc {
   int spp = 16;
   int max_depth = 1000;          ///< safety bound on scattering/bounce vertices per path
+  bool max_depth_set = false;    ///< the scene chose max_depth (e.g. 1: single scattering)
   uint64_t seed = 1;
   IntegratorKind kind = IntegratorKind::Auto;
   int64_t light_paths = 0;       ///< light tracing: paths in all; 0 = spp x width x height

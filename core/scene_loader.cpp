@@ -27,6 +27,15 @@ using Keys = std::vector<std::string>;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr std::uint64_t kMaxFilmBytes = 64ull << 30;  // guards against typos like 1e6 bins
+// Bounds of docs/scene-format.md ("Bounds"): values become floats (Embree, the film) or ints.
+constexpr double kMaxMagnitude = 1e9;    // any number, in its unit
+constexpr double kMinLength = 1e-6;      // mm: radii and widths that are inverted
+constexpr double kMinBinWidth = 1e-6;    // ps (or mm of OPL)
+constexpr double kMaxWindowEnd = 1e10;   // ps
+constexpr double kMinRate = 1e-9;        // per mm of OPL
+constexpr double kMinScale = 1e-6, kMaxScale = 1e6;
+constexpr int kMaxNesting = 64;          // JSON depth; scenes need fewer than 10 levels
+constexpr std::uint64_t kMaxSceneBytes = 64ull << 20;
 
 // ---------------------------------------------------------------------------------------------
 // Text helpers
@@ -42,7 +51,7 @@ std::string fmt(const Vec3& v) { return "[" + fmt(v.x) + ", " + fmt(v.y) + ", " 
 // JSON pointer escaping (RFC 6901), so a medium named "a/b" still yields a usable path.
 std::string escape_key(const std::string& key) {
   std::string out;
-  for (char ch : key) {
+  for (char ch : clip(key, 40)) {  // a path is for messages: keep each step short
     if (ch == '~')
       out += "~0";
     else if (ch == '/')
@@ -61,14 +70,10 @@ std::string at(const std::string& path, std::size_t index) {
 }
 
 // A value as shown after "got": compact, and short so the message stays readable on one line.
+// Values are at most kMaxNesting deep (checked while parsing), so dump() cannot recurse far.
 std::string show(const Json& v) {
-  std::string s = v.dump();
-  if (s.size() > 60) {
-    std::size_t n = 57;
-    while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // keep UTF-8 whole
-    s = s.substr(0, n) + "...";
-  }
-  return s;
+  if (v.is_string()) return clip(Json(clip(v.get<std::string>(), 200)).dump());
+  return clip(v.dump());
 }
 
 std::size_t edit_distance(const std::string& a, const std::string& b) {
@@ -88,9 +93,12 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 
 // " (did you mean 'x'?)" for the closest option within edit distance 2, else "".
 std::string suggest(const std::string& got, const Keys& options) {
+  constexpr std::size_t kMaxLen = 64;  // edit distance is quadratic: long names get no hint
+  if (got.size() > kMaxLen) return "";
   std::size_t best = 3;
   std::string pick;
   for (const auto& o : options) {
+    if (o.size() > kMaxLen || o.size() + 2 < got.size() || got.size() + 2 < o.size()) continue;
     const std::size_t d = edit_distance(got, o);
     if (d < best) {
       best = d;
@@ -100,9 +108,12 @@ std::string suggest(const std::string& got, const Keys& options) {
   return pick.empty() ? "" : " (did you mean '" + pick + "'?)";
 }
 
+// At most 10 entries, each clipped: the list is user data when it names media.
 std::string quoted_list(const Keys& options) {
   std::string s;
-  for (std::size_t i = 0; i < options.size(); ++i) s += (i ? ", \"" : "\"") + options[i] + "\"";
+  const std::size_t n = std::min<std::size_t>(options.size(), 10);
+  for (std::size_t i = 0; i < n; ++i) s += (i ? ", \"" : "\"") + clip(options[i], 40) + "\"";
+  if (options.size() > n) s += " and " + std::to_string(options.size() - n) + " more";
   return s;
 }
 
@@ -267,7 +278,7 @@ class Loader {
   std::string source_, base_dir_;
 
   [[noreturn]] void fail(const std::string& path, const std::string& problem) const {
-    throw InputError(source_ + ": " + (path.empty() ? "/" : path) + ": " + problem);
+    throw InputError(clip(source_, 200) + ": " + (path.empty() ? "/" : path) + ": " + problem);
   }
   [[noreturn]] void fail(const std::string& path, const std::string& problem,
                          const Json& got) const {
@@ -287,8 +298,19 @@ class Loader {
       std::set<std::string> keys;
     };
     std::vector<Frame> stack;
-    const Json::parser_callback_t cb = [&](int, nlohmann::json::parse_event_t ev, Json& parsed) {
+    const auto path_of_stack = [&] {
+      std::string path;
+      for (std::size_t i = 0; i + 1 < stack.size(); ++i)
+        path = stack[i].array ? at(path, stack[i].index) : at(path, stack[i].key);
+      return clip(path, 200);
+    };
+    const Json::parser_callback_t cb = [&](int depth, nlohmann::json::parse_event_t ev,
+                                           Json& parsed) {
       using E = nlohmann::json::parse_event_t;
+      // Deep nesting would make printing and freeing the value recurse past the stack.
+      if ((ev == E::object_start || ev == E::array_start) && depth >= kMaxNesting)
+        fail(path_of_stack(), "values are nested more than " + std::to_string(kMaxNesting) +
+                                  " levels deep; a scene needs far fewer");
       auto next_element = [&] {
         if (!stack.empty() && stack.back().array) ++stack.back().index;
       };
@@ -302,12 +324,7 @@ class Loader {
         case E::key: {
           const std::string k = parsed.get<std::string>();
           Frame& f = stack.back();
-          if (!f.keys.insert(k).second) {
-            std::string path;
-            for (std::size_t i = 0; i + 1 < stack.size(); ++i)
-              path = stack[i].array ? at(path, stack[i].index) : at(path, stack[i].key);
-            fail(at(path, k), "duplicate key '" + k + "'");
-          }
+          if (!f.keys.insert(k).second) fail(at(path_of_stack(), k), "duplicate key '" + clip(k) + "'");
           f.key = k;
           break;
         }
@@ -328,7 +345,7 @@ class Loader {
       const std::string what = e.what();
       const std::size_t k = what.find(": ", what.find("parse error"));
       const std::string msg = k == std::string::npos ? what : what.substr(k + 2);
-      throw InputError(source_ + ": " + line_col(text, e.byte) + ": " + msg);
+      throw InputError(clip(source_, 200) + ": " + line_col(text, e.byte) + ": " + clip(msg, 200));
     } catch (const nlohmann::json::exception& e) {
       // e.g. "number overflow parsing '1e999'": locate the quoted token to give a position.
       std::string what = e.what();
@@ -339,7 +356,7 @@ class Loader {
         const std::size_t pos = text.find(what.substr(q0 + 1, q1 - q0 - 1));
         if (pos != std::string::npos) where = line_col(text, pos + 1) + ": ";
       }
-      throw InputError(source_ + ": " + where + what);
+      throw InputError(clip(source_, 200) + ": " + where + clip(what, 200));
     }
   }
 
@@ -369,8 +386,8 @@ class Loader {
       const std::string& k = item.key();
       if (std::find(allowed.begin(), allowed.end(), k) != allowed.end()) continue;
       if (std::find(elsewhere.begin(), elsewhere.end(), k) != elsewhere.end())
-        fail(at(path, k), "key '" + k + "' does not apply to " + what);
-      fail(at(path, k), "unknown key '" + k + "'" + suggest(k, allowed));
+        fail(at(path, k), "key '" + clip(k) + "' does not apply to " + what);
+      fail(at(path, k), "unknown key '" + clip(k) + "'" + suggest(k, allowed));
     }
   }
 
@@ -379,6 +396,15 @@ class Loader {
     const double x = v.get<double>();
     if (!std::isfinite(x)) fail(path, "must be finite", v);
     if (!r.contains(x)) fail(path, r.text(), v);
+    if (std::abs(x) > kMaxMagnitude)
+      fail(path, "must be within +-1e9, the bound for every number (docs/scene-format.md, Bounds)",
+           v);
+    return x;
+  }
+
+  /// Rejects a positive value below `lo` (lengths and rates that get inverted).
+  double not_tiny(double x, double lo, const std::string& path, const Json& v) const {
+    if (x < lo) fail(path, "must be >= " + fmt(lo) + " (docs/scene-format.md, Bounds)", v);
     return x;
   }
 
@@ -501,7 +527,8 @@ class Loader {
       if (const Json* f = find(o, "fov"))
         c.fov_deg = number(*f, at(p, "fov"), within(0, 180, true, true));
     } else {
-      c.ortho_width = number(require(o, p, "width"), at(p, "width"), above(0));
+      const Json& w = require(o, p, "width");
+      c.ortho_width = not_tiny(number(w, at(p, "width"), above(0)), kMinLength, at(p, "width"), w);
     }
 
     const std::string rp = at(p, "resolution");
@@ -534,10 +561,12 @@ class Loader {
 
     TimeAxis& axis = scene.time;
     if (bw) {
-      axis.bin_width_ps = number(*bw, at(p, "bin_width"), above(0));
+      axis.bin_width_ps =
+          not_tiny(number(*bw, at(p, "bin_width"), above(0)), kMinBinWidth, at(p, "bin_width"), *bw);
       if (const Json* s = find(o, "t_start")) axis.t_start_ps = number(*s, at(p, "t_start"));
     } else {
-      axis.bin_width_ps = TimeAxis::time_of_opl(number(*bw_opl, at(p, "bin_width_opl"), above(0)));
+      axis.bin_width_ps = TimeAxis::time_of_opl(not_tiny(number(*bw_opl, at(p, "bin_width_opl"), above(0)),
+                                                         kMinBinWidth, at(p, "bin_width_opl"), *bw_opl));
       if (const Json* s = find(o, "start_opl"))
         axis.t_start_ps = TimeAxis::time_of_opl(number(*s, at(p, "start_opl")));
       else
@@ -545,6 +574,10 @@ class Loader {
     }
     const Json& bins = require(o, p, "bins");
     axis.bins = int_in(bins, at(p, "bins"), 1, 100000);
+    if (axis.t_end_ps() > kMaxWindowEnd)
+      fail(at(p, "bins"), "the window ends at " + fmt(axis.t_end_ps()) + " ps, beyond the bound of " +
+                              fmt(kMaxWindowEnd) + " ps (docs/scene-format.md, Bounds)",
+           bins);
 
     const std::uint64_t bytes = std::uint64_t(scene.camera.width) *
                                 std::uint64_t(scene.camera.height) * std::uint64_t(axis.bins) * 3u *
@@ -641,7 +674,7 @@ class Loader {
     if (file.empty()) fail(fp, "must name a VDB file", jf);
     d.file = resolve(file);
     std::error_code ec;
-    if (!fs::is_regular_file(d.file, ec)) fail(fp, "VDB file not found: " + d.file, jf);
+    if (!fs::is_regular_file(d.file, ec)) fail(fp, "VDB file not found: " + clip(d.file, 200), jf);
     const auto grid_name = [&](const std::string& key) {
       const std::string s = string(o.at(key), at(mp, key));
       if (s.empty()) fail(at(mp, key), "must name a grid", o.at(key));
@@ -706,7 +739,8 @@ class Loader {
       if (m.sampling == DistanceSampling::Mfp)
         fail(at(mp, "time_uniform_rate"),
              "only applies with \"distance_sampling\": \"time_uniform\" or \"mis\"" + uses, *r);
-      m.time_uniform_rate = number(*r, at(mp, "time_uniform_rate"), above(0));
+      m.time_uniform_rate =
+          not_tiny(number(*r, at(mp, "time_uniform_rate"), above(0)), kMinRate, at(mp, "time_uniform_rate"), *r);
     }
     if (const Json* h = find(o, "mis_heuristic")) {
       if (m.sampling != DistanceSampling::Mis)
@@ -725,11 +759,11 @@ class Loader {
       if (scene.media[i].name == name) return static_cast<int>(i);
       names.push_back(scene.media[i].name);
     }
-    if (names.empty()) fail(path, "unknown medium '" + name + "' (\"media\" defines none)", v);
-    fail(
-        path,
-        "unknown medium '" + name + "'" + suggest(name, names) + "; defined: " + quoted_list(names),
-        v);
+    if (names.empty()) fail(path, "unknown medium '" + clip(name) + "' (\"media\" defines none)", v);
+    fail(path,
+         "unknown medium '" + clip(name) + "'" + suggest(name, names) + "; defined: " +
+             quoted_list(names),
+         v);
   }
 
   PulseDesc pulse(const Json& v, const std::string& p) const {
@@ -789,16 +823,34 @@ class Loader {
       const std::string sp = at(p, "scale");
       if (s->is_number()) {
         tf.scale = Vec3(number(*s, sp));
-        if (tf.scale.x == 0) fail(sp, "must be non-zero", *s);
+        check_scale(tf.scale.x, sp, *s);
       } else {
         if (!s->is_array()) fail(sp, "expected a number or an array of 3 numbers", *s);
         tf.scale = vec3(*s, sp);
         for (int i = 0; i < 3; ++i)
-          if (tf.scale[i] == 0)
-            fail(at(sp, i), "must be non-zero", (*s)[static_cast<std::size_t>(i)]);
+          check_scale(tf.scale[i], at(sp, i), (*s)[static_cast<std::size_t>(i)]);
       }
     }
     return tf;
+  }
+
+  void check_scale(double x, const std::string& path, const Json& v) const {
+    if (x == 0) fail(path, "must be non-zero", v);
+    if (std::abs(x) < kMinScale || std::abs(x) > kMaxScale)
+      fail(path, "magnitude must be in [1e-6, 1e6] (docs/scene-format.md, Bounds)", v);
+  }
+
+  // Every vertex Embree sees must stay far inside float range (transforms can scale them out).
+  void check_vertices(const ShapeDesc& s, const std::string& path) const {
+    for (std::size_t i = 0; i < s.vertices.size(); ++i) {
+      const Vec3& q = s.vertices[i];
+      if (std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+          max_abs_component(q) <= kMaxMagnitude)
+        continue;
+      fail(path, "vertex " + std::to_string(i + 1) + " lands at " + fmt(q) +
+                     " mm, outside the bound of +-1e9 mm on every axis (docs/scene-format.md, "
+                     "Bounds)");
+    }
   }
 
   std::string resolve(const std::string& file) const {
@@ -827,7 +879,8 @@ class Loader {
       check_keys(o, p, join(common, {"center", "radius"}), "a sphere", specific);
       s.type = ShapeDesc::Type::Sphere;
       s.center = vec3(require(o, p, "center"), at(p, "center"));
-      s.radius = number(require(o, p, "radius"), at(p, "radius"), above(0));
+      const Json& jr = require(o, p, "radius");
+      s.radius = not_tiny(number(jr, at(p, "radius"), above(0)), kMinLength, at(p, "radius"), jr);
     } else if (type == "quad") {
       check_keys(o, p, join(common, {"corner", "edge1", "edge2"}), "a quad", specific);
       s.type = ShapeDesc::Type::Quad;
@@ -858,7 +911,7 @@ class Loader {
       if (file.empty()) fail(fp, "must name an OBJ file", jf);
       const std::string path = resolve(file);
       std::error_code ec;
-      if (!fs::is_regular_file(path, ec)) fail(fp, "mesh file not found: " + path, jf);
+      if (!fs::is_regular_file(path, ec)) fail(fp, "mesh file not found: " + clip(path, 200), jf);
       try {
         load_obj(path, s.vertices, s.triangles);
       } catch (const InputError& e) {
@@ -891,7 +944,7 @@ class Loader {
         const Json* e = find(mat, "eta");
         fail(e ? at(at(p, "material"), "eta") : at(p, "material"),
              dielectric + " eta " + fmt(s.material.eta) + (e ? "" : " (the default)") +
-                 " differs from eta " + fmt(md.medium.eta) + " of its interior medium '" + md.name +
+                 " differs from eta " + fmt(md.medium.eta) + " of its interior medium '" + clip(md.name) +
                  "'; they must be equal",
              e ? *e : mat);
       }
@@ -907,7 +960,12 @@ class Loader {
     if (s.material.type == MaterialDesc::Type::None && s.interior_medium < 0 && !s.emissive)
       fail(p, "shape has no 'material', 'medium' or 'emission', so it would be invisible");
 
-    if (const Json* t = find(o, "transform")) apply_transform(transform(*t, at(p, "transform")), s);
+    const Json* t = find(o, "transform");
+    if (t) apply_transform(transform(*t, at(p, "transform")), s);
+    check_vertices(s, at(p, t                                    ? "transform"
+                            : s.type == ShapeDesc::Type::Mesh ? "file"
+                            : s.type == ShapeDesc::Type::Box  ? "max"
+                                                              : "corner"));
     if (s.type == ShapeDesc::Type::Mesh &&
         (s.interior_medium >= 0 || s.material.is_transmissive())) {
       const std::string problem = closed_mesh_problem(s.vertices, s.triangles);
@@ -959,7 +1017,8 @@ class Loader {
       l.position = vec3(require(o, p, "position"), at(p, "position"));
       if (l.type != LightDesc::Type::Point) l.direction = aim(o, p, l.position);
       if (l.type == LightDesc::Type::Laser) {
-        l.radius = number(require(o, p, "radius"), at(p, "radius"), above(0));
+        const Json& jr = require(o, p, "radius");
+        l.radius = not_tiny(number(jr, at(p, "radius"), above(0)), kMinLength, at(p, "radius"), jr);
         l.power = bright_rgb(require(o, p, "power"), at(p, "power"));
       } else {
         l.intensity = bright_rgb(require(o, p, "intensity"), at(p, "intensity"));
@@ -1009,8 +1068,10 @@ class Loader {
     if (const Json* s = find(o, "light_paths"))
       d.light_paths = integer(*s, at(p, "light_paths"), 1, 1000000000000LL);
     if (const Json* s = find(o, "photons")) photons(*s, at(p, "photons"), d.photons);
-    if (const Json* s = find(o, "max_depth"))
+    if (const Json* s = find(o, "max_depth")) {
       d.max_depth = int_in(*s, at(p, "max_depth"), 1, 1000000);
+      d.max_depth_set = true;
+    }
     if (const Json* s = find(o, "seed")) {
       // Seeds span the full uint64 range, beyond what integer() reads.
       if (s->is_number_unsigned())
@@ -1028,15 +1089,25 @@ SceneDesc load_scene_string(const std::string& json_text, const std::string& sou
   return Loader(source, base_dir).load(json_text);
 }
 
-SceneDesc load_scene_file(const std::string& path) {
+std::string read_scene_text(const std::string& path) {
+  const std::string name = clip(path, 200);
   std::error_code ec;
-  if (fs::is_directory(path, ec)) throw InputError(path + ": is a directory, not a scene file");
-  if (!fs::exists(path, ec)) throw InputError(path + ": scene file not found");
+  if (fs::is_directory(path, ec)) throw InputError(name + ": is a directory, not a scene file");
+  if (!fs::exists(path, ec)) throw InputError(name + ": scene file not found");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open scene file");
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw InputError(path + ": cannot read scene file");
-  return load_scene_string(text, path, fs::path(path).parent_path().string());
+  if (!in) throw InputError(name + ": cannot open scene file");
+  // Read at most one byte past the limit: /dev/zero or a pipe must not be read forever.
+  std::string text(kMaxSceneBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw InputError(name + ": cannot read scene file");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxSceneBytes)
+    throw InputError(name + ": scene file is larger than the 64 MiB limit");
+  return text;
+}
+
+SceneDesc load_scene_file(const std::string& path) {
+  return load_scene_string(read_scene_text(path), path, fs::path(path).parent_path().string());
 }
 
 }  // namespace femto

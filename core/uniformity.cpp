@@ -42,6 +42,22 @@ struct Collector {
   }
 };
 
+// Groups adjacent bins so that each cell expects at least 5 of the n times: with fewer than
+// 5 x bins times the chi-square test would otherwise pool every bin into a single cell.
+void merge_bins(const std::vector<double>& counts, double n, std::vector<double>& observed,
+                std::vector<double>& expected) {
+  const size_t bins = counts.size();
+  const size_t per = std::max<size_t>(1, static_cast<size_t>(std::ceil(5.0 * static_cast<double>(bins) / n)));
+  const size_t cells = bins / per;  // the last cell takes the remainder
+  observed.assign(cells, 0.0);
+  expected.assign(cells, 0.0);
+  for (size_t b = 0; b < bins && cells > 0; ++b) {
+    const size_t k = std::min(b / per, cells - 1);
+    observed[k] += counts[b];
+    expected[k] += n / static_cast<double>(bins);
+  }
+}
+
 void fill_statistics(const Config& c, Result& r, const std::vector<double>& times) {
   r.in_range = times.size();
   r.counts.assign(static_cast<size_t>(c.bins), 0.0);
@@ -58,10 +74,22 @@ void fill_statistics(const Config& c, Result& r, const std::vector<double>& time
     r.pass = false;
     return;
   }
-  const std::vector<double> expected(static_cast<size_t>(c.bins), r.expected_per_bin);
-  r.chi2 = stats::chi2_test(r.counts, expected);
   r.ks_d = stats::ks_statistic_uniform(times, r.range_lo_ps, r.range_hi_ps);
   r.ks_p = stats::ks_p_value(r.ks_d, times.size());
+  std::vector<double> observed, expected;
+  merge_bins(r.counts, static_cast<double>(times.size()), observed, expected);
+  if (observed.size() < 2) {
+    r.note += std::string(r.note.empty() ? "" : "; ") +
+              "fewer than 10 times inside the range: too few for the chi-square test";
+    r.chi2 = {NAN, 0, NAN, 0, 0};
+    r.pass = false;
+    return;
+  }
+  if (observed.size() < r.counts.size())
+    r.note += std::string(r.note.empty() ? "" : "; ") + "adjacent bins merged into " +
+              std::to_string(observed.size()) +
+             " cells for the chi-square test (at least 5 expected times each)";
+  r.chi2 = stats::chi2_test(observed, expected);
   r.pass = r.chi2.p_value >= c.alpha && r.ks_p >= c.alpha;
 }
 
@@ -271,7 +299,7 @@ std::string format_table(const std::vector<Result>& results) {
                   strategy_name(r.strategy), static_cast<unsigned long long>(r.drawn),
                   static_cast<unsigned long long>(r.in_range), range, r.chi2.chi2, r.chi2.dof,
                   r.chi2.p_value, r.ks_d, r.ks_p,
-                  r.pass ? "uniform" : (r.valid && r.in_range >= 2 ? "NOT uniform" : "untested"));
+                  r.pass ? "uniform" : (r.valid && r.chi2.dof > 0 ? "NOT uniform" : "untested"));
     out += line;
   }
   return out;

@@ -15,7 +15,7 @@ namespace femto {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-int floor_int(double x) { return static_cast<int>(std::floor(x)); }
+int floor_int(double x) { return clamped_floor(x); }
 }  // namespace
 
 GridMedium::GridMedium(const VolumeData& data, const VdbMediumDesc& desc)
@@ -102,6 +102,8 @@ template <class Fetch>
 double interpolate(const Vec3& q, bool trilinear, Fetch fetch) {
   if (!trilinear) return fetch(floor_int(q.x), floor_int(q.y), floor_int(q.z));
   const int I = floor_int(q.x), J = floor_int(q.y), K = floor_int(q.z);
+  constexpr int kFar = 1 << 30;  // clamped: far outside, where every cell has the outside value
+  if (std::abs(I) == kFar || std::abs(J) == kFar || std::abs(K) == kFar) return fetch(I, J, K);
   const double fx = q.x - I, fy = q.y - J, fz = q.z - K;
   double v = 0;
   for (int c = 0; c < 8; ++c) {

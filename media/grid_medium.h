@@ -3,6 +3,7 @@
 // refractive index per voxel, interpolated `nearest` (piecewise constant cells) or `trilinear`.
 // Rays are walked cell by cell (3-D DDA) so optical depth and optical path length are exact;
 // blocks of 8^3 cells with no extinction and a constant index are crossed in one step.
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -10,6 +11,16 @@
 #include "media/poly3.h"
 
 namespace femto {
+
+/// floor(x) as an int, clamped to +-2^30 (NaN gives -2^30): points far outside every grid (long
+/// paths, wide pulses) must not overflow the conversion, which is undefined behaviour.
+inline int clamped_floor(double x) {
+  constexpr double kLimit = 1073741824.0;
+  const double f = std::floor(x);
+  if (f >= kLimit) return static_cast<int>(kLimit);
+  if (!(f > -kLimit)) return -static_cast<int>(kLimit);
+  return static_cast<int>(f);
+}
 
 struct VolumeData;
 struct VdbMediumDesc;

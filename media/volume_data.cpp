@@ -18,6 +18,7 @@
 #include "core/constants.h"
 #include "core/error.h"
 #include "core/io/atomic_file.h"
+#include "media/vdb_structure.h"
 
 namespace femto {
 
@@ -48,6 +49,13 @@ using openvdb::Coord;
 using openvdb::CoordBBox;
 using openvdb::FloatGrid;
 using openvdb::Vec3d;
+
+// Limits of docs/volumes.md ("Limits").
+constexpr uint64_t kMaxFileBytes = 16ull << 30;
+constexpr double kMaxCells = 1073741824.0;  // 2^30 = 1024^3 dense cells
+constexpr uint64_t kMaxDenseBytes = 16ull << 30;
+constexpr double kMaxWorld = 1e9;       // mm, as for scene coordinates
+constexpr double kMaxSigmaT = 1e9;      // 1/mm: sigma_t is stored as float
 
 void init_openvdb() {
   static std::once_flag once;
@@ -115,6 +123,13 @@ class VolumeLoader {
     std::error_code ec;
     if (!fs::exists(desc_.file, ec)) fail_file("file not found");
     if (fs::is_directory(desc_.file, ec)) fail_file("is a directory, not a VDB file");
+    if (!fs::is_regular_file(desc_.file, ec)) fail_file("is not a regular file");
+    const uint64_t file_bytes = fs::file_size(desc_.file, ec);
+    if (ec) fail_file("cannot read the file size (" + ec.message() + ")");
+    if (file_bytes > kMaxFileBytes) fail_file("the file is larger than the 16 GiB limit");
+    // Our own bounded checks first: OpenVDB trusts the sizes stored in the file.
+    if (const std::string p = vdb_structure_problem(desc_.file); !p.empty())
+      fail_file("corrupt or unsupported OpenVDB file: " + p);
 
     VolumeData out;
     std::vector<Used> used{{Role::Density, "density_grid", desc_.density_grid, {}, 0, &out.density}};
@@ -123,19 +138,7 @@ class VolumeLoader {
     if (!desc_.eta_grid.empty())
       used.push_back({Role::Eta, "eta_grid", desc_.eta_grid, {}, 0, &out.eta});
 
-    openvdb::io::File file(desc_.file);
-    try {
-      file.open(/*delayLoad=*/false);
-    } catch (const openvdb::Exception& e) {
-      fail_file(std::string("not a readable OpenVDB file (") + e.what() + ")");
-    }
-    try {
-      const openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();
-      for (Used& u : used) u.grid = read_grid(file, *metas, u);
-    } catch (const openvdb::Exception& e) {
-      fail_file(std::string("cannot read the file (") + e.what() + ")");
-    }
-    file.close();
+    read_grids(used);
 
     const FloatGrid& density = *used[0].grid;
     CoordBBox box;  // union of the active boxes; inactive cells inside take the fill value
@@ -150,19 +153,10 @@ class VolumeLoader {
       fail(used[0], "grid '" + used[0].name + "' has no active voxels, so the medium is empty");
     out.active_voxels = density.activeVoxelCount();
 
-    const Coord dim = box.dim();
-    const uint64_t cells = uint64_t(dim.x()) * uint64_t(dim.y()) * uint64_t(dim.z());
-    const uint64_t bytes = cells * sizeof(float) * used.size();
-    const std::string size = std::to_string(dim.x()) + " x " + std::to_string(dim.y()) + " x " +
-                             std::to_string(dim.z()) + " voxels";
-    if (cells > (uint64_t(1) << 31))
-      fail_file("the dense box " + fmt(box.min()) + " to " + fmt(box.max()) + " is " + size + " (" +
-                fmt(double(cells)) + " cells), above the limit of 2^31 cells");
-    if (bytes > (uint64_t(16) << 30))
-      fail_file("the dense box of " + size + " needs " + fmt(double(bytes) / double(1ull << 30)) +
-                " GiB for " + std::to_string(used.size()) + " grids, above the 16 GiB limit");
+    check_box(box.min(), box.max(), used.size(), "");
 
     for (Used& u : used) densify(u, box);
+    check_sigma_t(used[0], out.density);
     set_transform(out, density.transform(), box.min());
     for (int a = 0; a < 3; ++a) out.index_min[a] = box.min()[a];
     return out;
@@ -173,27 +167,92 @@ class VolumeLoader {
   std::string prefix_;
 
   [[noreturn]] void fail_at(const std::string& key, const std::string& problem) const {
-    throw InputError(prefix_ + key + ": " + desc_.file + ": " + problem);
+    throw InputError(prefix_ + key + ": " + clip(desc_.file, 200) + ": " + problem);
   }
   [[noreturn]] void fail_file(const std::string& problem) const { fail_at("file", problem); }
   [[noreturn]] void fail(const Used& u, const std::string& problem) const {
     fail_at(u.key, problem);
   }
 
+  // Every failure inside OpenVDB's reader, including running out of memory, is bad input.
+  void read_grids(std::vector<Used>& used) const {
+    try {
+      openvdb::io::File file(desc_.file);
+      file.open(/*delayLoad=*/false);
+      const openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();
+      for (Used& u : used) u.grid = read_grid(file, *metas, u, used.size());
+      file.close();
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::bad_alloc&) {
+      fail_file("cannot read the file: it asks for more memory than is available (corrupt?)");
+    } catch (const std::exception& e) {
+      fail_file("cannot read the file (" + clip(e.what(), 200) + ")");
+    } catch (...) {
+      fail_file("cannot read the file (unknown error in the OpenVDB reader)");
+    }
+    for (const Used& u : used)
+      if (!u.grid) fail(u, "grid '" + clip(u.name) + "' could not be read");
+  }
+
+  // Dense size of the box [lo, hi] in 64-bit arithmetic (hi - lo + 1 overflows int when the
+  // voxels are far apart), against the cell limit and the memory budget.
+  void check_box(const Coord& lo, const Coord& hi, std::size_t grids, const std::string& what) const {
+    int64_t dim[3];
+    double cells = 1;
+    for (int a = 0; a < 3; ++a) {
+      dim[a] = int64_t(hi[a]) - int64_t(lo[a]) + 1;
+      cells *= double(dim[a]);
+    }
+    const std::string size = std::to_string(dim[0]) + " x " + std::to_string(dim[1]) + " x " +
+                             std::to_string(dim[2]) + " voxels";
+    const std::string box = what + "dense box " + fmt(lo) + " to " + fmt(hi);
+    if (cells > kMaxCells)
+      fail_file("the " + box + " is " + size + " (" + fmt(cells) +
+                " cells), above the limit of 2^30 cells (docs/volumes.md, Limits)");
+    const uint64_t bytes = uint64_t(cells) * sizeof(float) * grids;
+    const uint64_t limit = std::min(kMaxDenseBytes, desc_.max_dense_bytes);
+    if (bytes > limit)
+      fail_file("the " + box + " (" + size + ") needs " + fmt(double(bytes) / double(1ull << 20)) +
+                " MiB for " + std::to_string(grids) + " grid(s), above the limit of " +
+                fmt(double(limit) / double(1ull << 20)) + " MiB" +
+                (limit < kMaxDenseBytes ? " left by --max-memory" : "") + " (docs/volumes.md, Limits)");
+  }
+
+  // sigma_t is stored as float; a finite density times the scale can still overflow it.
+  void check_sigma_t(const Used& d, const DenseGrid& g) const {
+    if (desc_.sigma_t_scale * g.max_value > kMaxSigmaT)
+      fail(d, "grid '" + clip(d.name) + "' density " + fmt(g.max_value) + " times sigma_t_scale " +
+                  fmt(desc_.sigma_t_scale) + " exceeds the bound of 1e9 /mm for sigma_t");
+  }
+
+  // The grid's box as stored in its metadata (written by OpenVDB), checked before the tree is
+  // read so that a huge box is refused before OpenVDB allocates it.
+  void check_metadata_box(const openvdb::GridBase& meta, std::size_t grids) const {
+    const auto lo = meta.getMetadata<openvdb::Vec3IMetadata>("file_bbox_min");
+    const auto hi = meta.getMetadata<openvdb::Vec3IMetadata>("file_bbox_max");
+    if (!lo || !hi) return;
+    const Coord a(lo->value()), b(hi->value());
+    if (a.x() > b.x() || a.y() > b.y() || a.z() > b.z()) return;  // empty grid
+    check_box(a, b, grids, "grid '" + clip(meta.getName()) + "' ");
+  }
+
   FloatGrid::Ptr read_grid(openvdb::io::File& file, const openvdb::GridPtrVec& metas,
-                           const Used& u) const {
+                           const Used& u, std::size_t grids) const {
     openvdb::GridBase::Ptr meta;
     std::string available;
     for (const auto& g : metas) {
       if (g->getName() == u.name && !meta) meta = g;
-      available += (available.empty() ? "'" : ", '") + g->getName() + "' (" + g->valueType() + ")";
+      if (available.size() < 400)  // names come from the file: keep the message short
+        available += (available.empty() ? "'" : ", '") + clip(g->getName()) + "' (" +
+                     clip(g->valueType()) + ")";
     }
-    const std::string grid = "grid '" + u.name + "'";
+    const std::string grid = "grid '" + clip(u.name) + "'";
     if (!meta)
-      fail(u, "no grid named '" + u.name + "'; the file has " +
-                  (available.empty() ? std::string("no grids") : available));
+      fail(u, "no grid named '" + clip(u.name) + "'; the file has " +
+                  (available.empty() ? std::string("no grids") : clip(available, 400)));
     if (!meta->isType<FloatGrid>())
-      fail(u, grid + " holds " + meta->valueType() + " values (" + meta->type() +
+      fail(u, grid + " holds " + clip(meta->valueType()) + " values (" + clip(meta->type()) +
                   "); femto needs a FloatGrid (float values)");
     const openvdb::GridClass cls = meta->getGridClass();
     if (u.role == Role::Density && cls == openvdb::GRID_LEVEL_SET)
@@ -205,6 +264,7 @@ class VolumeLoader {
     if (!meta->transform().isLinear())
       fail(u, grid + " has a non-linear transform (" + meta->transform().mapType() +
                   "); only affine (linear) transforms are supported");
+    check_metadata_box(*meta, grids);
     return openvdb::gridPtrCast<FloatGrid>(file.readGrid(u.name));
   }
 
@@ -214,21 +274,21 @@ class VolumeLoader {
     const auto close = [](const Vec3d& x, const Vec3d& y) {
       return (x - y).length() <= 1e-9 * std::max({1.0, x.length(), y.length()});
     };
-    const std::string rule = "; all grids must share the transform of density grid '" + d.name + "'";
+    const std::string rule = "; all grids must share the transform of density grid '" + clip(d.name) + "'";
     if (!close(a.voxelSize(), b.voxelSize()))
-      fail(u, "grid '" + u.name + "' has voxel size " + fmt(a.voxelSize()) + " mm but '" + d.name +
+      fail(u, "grid '" + clip(u.name) + "' has voxel size " + fmt(a.voxelSize()) + " mm but '" + clip(d.name) +
                   "' has " + fmt(b.voxelSize()) + rule);
     for (const Vec3d p : {Vec3d(0, 0, 0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(0, 0, 1)})
       if (!close(a.indexToWorld(p), b.indexToWorld(p)))
-        fail(u, "grid '" + u.name + "' is offset or rotated: its voxel " + fmt(Coord::round(p)) +
-                    " is at " + fmt(a.indexToWorld(p)) + " mm but in '" + d.name + "' at " +
+        fail(u, "grid '" + clip(u.name) + "' is offset or rotated: its voxel " + fmt(Coord::round(p)) +
+                    " is at " + fmt(a.indexToWorld(p)) + " mm but in '" + clip(d.name) + "' at " +
                     fmt(b.indexToWorld(p)) + rule);
   }
 
   // Sets the fill value of inactive cells from the background (see docs/volumes.md).
   void check_background(Used& u) const {
     const float bg = u.grid->background();
-    const std::string grid = "grid '" + u.name + "' background";
+    const std::string grid = "grid '" + clip(u.name) + "' background";
     if (u.role == Role::Density) {
       if (bg != 0.0f)
         fail(u, grid + " must be 0, since inactive voxels are empty space (got " + fmt(bg) + ")");
@@ -244,18 +304,20 @@ class VolumeLoader {
 
   // Copies the active values into a dense grid over `box`, validating each one.
   void densify(Used& u, const CoordBBox& box) const {
-    const Coord o = box.min(), dim = box.dim();
+    const Coord o = box.min();
+    const auto extent = [&](int a) { return int(int64_t(box.max()[a]) - int64_t(o[a]) + 1); };
     DenseGrid& d = *u.dense;
-    d = DenseGrid(dim.x(), dim.y(), dim.z(), u.fill);
+    d = DenseGrid(extent(0), extent(1), extent(2), u.fill);
     for (auto it = u.grid->cbeginValueOn(); it; ++it) {
       const float x = *it;
       const CoordBBox b = it.getBoundingBox();  // one voxel, or an active tile
       if (const std::string p = value_problem(u.role, x); !p.empty())
-        fail(u, "grid '" + u.name + "' voxel " + fmt(b.min()) + ": " + p + " (got " + fmt(x) + ")");
-      for (int k = b.min().z(); k <= b.max().z(); ++k)
-        for (int j = b.min().y(); j <= b.max().y(); ++j)
-          for (int i = b.min().x(); i <= b.max().x(); ++i)
-            d.at(i - o.x(), j - o.y(), k - o.z()) = x;
+        fail(u, "grid '" + clip(u.name) + "' voxel " + fmt(b.min()) + ": " + p + " (got " + fmt(x) + ")");
+      // 64-bit counters: a voxel at INT_MAX would make `++i` overflow.
+      for (int64_t k = b.min().z(); k <= b.max().z(); ++k)
+        for (int64_t j = b.min().y(); j <= b.max().y(); ++j)
+          for (int64_t i = b.min().x(); i <= b.max().x(); ++i)
+            d.at(int(i - o.x()), int(j - o.y()), int(k - o.z())) = x;
     }
     d.update_range();
   }
@@ -302,6 +364,11 @@ class VolumeLoader {
     }
     out.world_bounds_min = lo;
     out.world_bounds_max = hi;
+    const double far = std::max(max_abs_component(lo), max_abs_component(hi));
+    if (!(far <= kMaxWorld))  // also NaN: the renderer works in float far inside this
+      fail_file("the grid's world box " + fmt(Vec3d(lo.x, lo.y, lo.z)) + " to " +
+                fmt(Vec3d(hi.x, hi.y, hi.z)) +
+                " mm reaches beyond +-1e9 mm (voxel size, file transform or the scene's transform)");
   }
 };
 
@@ -310,15 +377,18 @@ openvdb::GridBase::Ptr make_grid(const VdbGridSpec& s) {
   using V = typename GridT::ValueType;
   const auto grid = GridT::create(static_cast<V>(s.background));
   auto acc = grid->getAccessor();
-  const DenseGrid& d = *s.values;
   const Coord off(static_cast<int>(s.index_offset.x), static_cast<int>(s.index_offset.y),
                   static_cast<int>(s.index_offset.z));
-  for (int k = 0; k < d.nz; ++k)
-    for (int j = 0; j < d.ny; ++j)
-      for (int i = 0; i < d.nx; ++i) {
-        const float x = d.at(i, j, k);
-        if (!(x == s.background)) acc.setValue(off + Coord(i, j, k), static_cast<V>(x));  // NaN too
-      }
+  if (s.values) {
+    const DenseGrid& d = *s.values;
+    for (int k = 0; k < d.nz; ++k)
+      for (int j = 0; j < d.ny; ++j)
+        for (int i = 0; i < d.nx; ++i) {
+          const float x = d.at(i, j, k);
+          if (!(x == s.background)) acc.setValue(off + Coord(i, j, k), static_cast<V>(x));  // NaN too
+        }
+  }
+  for (const auto& [c, x] : s.voxels) acc.setValue(Coord(c[0], c[1], c[2]), static_cast<V>(x));
   grid->tree().prune();  // merges constant active blocks into tiles: smaller files
   return grid;
 }
@@ -340,7 +410,8 @@ void write_vdb(const std::string& path, const std::vector<VdbGridSpec>& grids) {
   init_openvdb();
   openvdb::GridPtrVec out;
   for (const VdbGridSpec& s : grids) {
-    if (!s.values || s.values->empty()) throw RuntimeError("write_vdb: grid '" + s.name + "' is empty");
+    if ((!s.values || s.values->empty()) && s.voxels.empty())
+      throw RuntimeError("write_vdb: grid '" + s.name + "' is empty");
     openvdb::GridBase::Ptr g = s.type == VdbGridSpec::Type::Float ? make_grid<FloatGrid>(s)
                                                                   : make_grid<openvdb::DoubleGrid>(s);
     g->setName(s.name);

@@ -1,9 +1,11 @@
 #pragma once
 // Heterogeneous volumes read from OpenVDB files into dense in-memory grids (docs/volumes.md).
 // OpenVDB itself stays inside volume_data.cpp; this header is plain data.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/scene_desc.h"
@@ -81,6 +83,9 @@ struct VdbGridSpec {
   Vec3 origin_mm{0, 0, 0};            ///< world position of the lower corner of cell (0,0,0)
   Vec3 index_offset{0, 0, 0};         ///< VDB index of cell (0,0,0) (integers); moves nothing in world
   bool frustum = false;               ///< a non-linear (frustum) transform, for tests
+  /// Single active voxels (VDB index, value) written in addition to `values`, which may then be
+  /// null: sparse grids spanning far-apart coordinates, for tests.
+  std::vector<std::pair<std::array<int, 3>, float>> voxels;
 };
 
 /// Writes grids to a .vdb file atomically (temp + rename). Throws RuntimeError on I/O failure.

@@ -542,7 +542,7 @@ TEST_CASE("cli: same seed gives identical bytes for any thread count", "[cli]") 
     REQUIRE(r.code == 0);
     const json info = json::parse(read_text(out / "render.json"));
     CHECK(info.at("settings").at("seed").get<uint64_t>() == std::stoull(seed));
-    CHECK(info.at("settings").at("threads").get<int>() == std::stoi(threads));
+    CHECK(info.at("settings").at("threads_requested").get<int>() == std::stoi(threads));
     return read_bytes(out / "transient.npy");
   };
   const std::vector<char> a = render("a", "7", "1");

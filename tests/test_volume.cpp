@@ -242,22 +242,24 @@ TEST_CASE("bad volumes: transforms, backgrounds, non-finite values, sizes", "[vd
     CHECK_THAT(load_error(d), Catch::Contains("/media/m/eta_grid") && Catch::Contains("double") &&
                                   Catch::Contains("FloatGrid"));
   }
-  SECTION("dense box above 2^31 cells") {
+  SECTION("dense box above 2^30 cells") {
     // Two single voxels far apart: the union of the active boxes is 2001 x 2001 x 1001 cells.
     const DenseGrid one(1, 1, 1, 1.5f);
     VdbGridSpec e = grid_spec("eta", one);
     e.index_offset = {2000, 2000, 1000};
     e.origin_mm = e.index_offset;  // same transform as the density grid (voxel 1 mm)
     write({grid_spec("density", DenseGrid(1, 1, 1, 1.0f)), e});
-    CHECK_THAT(load_error(d), Catch::Contains("2001 x 2001 x 1001") && Catch::Contains("2^31"));
+    CHECK_THAT(load_error(d), Catch::Contains("2001 x 2001 x 1001") && Catch::Contains("2^30"));
   }
-  SECTION("dense grids above 16 GiB") {
+  SECTION("dense grids above the memory left by --max-memory") {
     const DenseGrid one(1, 1, 1, 0.5f), eta_one(1, 1, 1, 1.5f);
     VdbGridSpec a = grid_spec("albedo", one), e = grid_spec("eta", eta_one);
-    e.index_offset = e.origin_mm = {1279, 1279, 1279};  // 1280^3 cells x 3 grids x 4 bytes
+    e.index_offset = e.origin_mm = {127, 127, 127};  // 128^3 cells x 3 grids x 4 bytes = 24 MiB
     write({grid_spec("density", one), a, e});
     d.albedo_grid = "albedo";
-    CHECK_THAT(load_error(d), Catch::Contains("1280 x 1280 x 1280") && Catch::Contains("16 GiB"));
+    d.max_dense_bytes = 16ull << 20;
+    CHECK_THAT(load_error(d), Catch::Contains("128 x 128 x 128") && Catch::Contains("24 MiB") &&
+                                  Catch::Contains("--max-memory"));
   }
   SECTION("unreadable path: a folder") {
     CHECK_THAT(load_error(desc_for(fs::path(d.file).parent_path().string())),

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "core/diffusion/models.h"
 #include "core/progress.h"
@@ -24,6 +25,19 @@ void trace_photon(const PhotonTransport& transport, double t_end, Rng rng, Photo
   p.d = sample_uniform_sphere(u1, u2);
   while (p.alive && p.t < t_end) tally.add(transport.advance(p, rng));
 }
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// After the first round: how long all N photons will take, and how to stop earlier.
+void print_estimate(double seconds, uint64_t done, uint64_t N) {
+  if (done >= N || seconds <= 0) return;
+  const double total = seconds * static_cast<double>(N) / static_cast<double>(done);
+  std::fprintf(stderr,
+               "diffusion: about %s for %llu photons; Ctrl-C (or --max-seconds) stops early and "
+               "writes the photons traced so far\n",
+               format_duration(total).c_str(), static_cast<unsigned long long>(N));
+}
 }  // namespace
 
 DiffusionResult simulate(const DiffusionSetup& setup) {
@@ -35,7 +49,8 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
   const Grid& grid = setup.grid;
   const TallyLayout layout{grid.shells, grid.time.bins};
   const uint64_t N = setup.photons;
-  const int threads = setup.threads > 0 ? setup.threads : tbb::info::default_concurrency();
+  const int hardware = tbb::info::default_concurrency();  // oneTBB runs no more than this
+  const int threads = setup.threads > 0 ? std::min(setup.threads, hardware) : hardware;
   const uint64_t batches = (N + kBatch - 1) / kBatch;
   // Batches in flight per round: two per thread, within 1 GiB of partial sums.
   const size_t slot_bytes = 2 * sizeof(double) * layout.size();
@@ -44,6 +59,7 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
 
   TallySums total;
   total.reset(layout.size());
+  bool stopped_early = false;
   std::vector<TallySums> partial(slots);
   tbb::enumerable_thread_specific<PhotonTally> tallies([&] { return PhotonTally(grid); });
   Progress progress(N, "diffusion", setup.quiet);
@@ -64,12 +80,21 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
       });
     });
     for (size_t k = 0; k < count; ++k) total.add(partial[k]);  // batch order: thread-independent
+    const double elapsed = seconds_since(start);
+    if (first == 0 && !setup.quiet) print_estimate(elapsed, slots * kBatch, N);
+    const bool more = first + slots < batches;
+    if (more && ((setup.stop && setup.stop->load()) ||
+                 (setup.max_seconds > 0 && elapsed >= setup.max_seconds))) {
+      stopped_early = true;
+      break;
+    }
   }
   progress.finish();
 
   DiffusionResult r;
   r.grid = grid;
   r.photons = total.photons;
+  r.stopped_early = stopped_early;
   r.segments = total.segments;
   r.threads = threads;
   const double n = static_cast<double>(std::max<uint64_t>(total.photons, 1));

@@ -4,6 +4,7 @@
 // radial shells and time bins, with per-photon standard errors. Multi-threaded (oneTBB) and
 // bit-identical for any thread count: photon i always uses Rng::for_sample(seed, i, 0), photons
 // are summed in order within fixed batches and batches are reduced in order.
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -25,6 +26,10 @@ struct DiffusionSetup {
   /// bin instead of the exact exp(-sigma_a v t) of `medium` (for heterogeneous media, where no
   /// closed form exists; a ratio estimator, consistent, with errors combined as independent).
   bool normalise_by_energy = false;
+  /// Ends the run early, between rounds of batches, with the photons traced so far (an unbiased
+  /// estimate from fewer photons): a flag set from outside (Ctrl-C), and a time budget.
+  const std::atomic<bool>* stop = nullptr;
+  double max_seconds = 0;  ///< 0: no limit
 };
 
 /// Means and standard errors per unit emitted energy. Per-bin values are averages over the bin.
@@ -40,7 +45,8 @@ struct DiffusionResult {
   std::vector<double> r2, r2_err, r4, r4_err;
   /// Fractions of the (exact mean) energy present that are unscattered and singly scattered.
   std::vector<double> unscattered, unscattered_err, single, single_err;
-  uint64_t photons = 0, segments = 0;
+  uint64_t photons = 0, segments = 0;  ///< photons traced (fewer than asked when stopped early)
+  bool stopped_early = false;
   int threads = 0;
   double seconds = 0;
 

@@ -1,0 +1,148 @@
+#include "media/vdb_structure.h"
+
+#include <cstdint>
+#include <fstream>
+
+namespace femto {
+namespace {
+
+constexpr int64_t kMagic = 0x56444220;  // "VDB " as a little-endian int64
+constexpr uint32_t kOldestVersion = 219;  // file format with grid offsets and no grid map
+constexpr uint32_t kNewestVersion = 224;  // what the linked OpenVDB 10 writes
+constexpr uint32_t kMaxString = 1u << 20;  // names and type names; real ones are short
+constexpr uint32_t kKnownCompression = 0x7;  // zip | active mask | blosc
+
+struct Bad {
+  std::string what;
+};
+
+/// Little-endian reads that never go past `end` (the file size, or a grid's end offset).
+class Reader {
+ public:
+  Reader(std::ifstream& in, uint64_t size) : in_(in), end_(size), size_(size) {}
+
+  uint64_t pos() const { return pos_; }
+  uint64_t size() const { return size_; }
+  void set_end(uint64_t end) { end_ = end; }
+
+  template <class T>
+  T read(const std::string& what) {
+    T v{};
+    bytes(reinterpret_cast<char*>(&v), sizeof v, what);
+    return v;
+  }
+
+  std::string string(const std::string& what) {
+    const uint32_t n = read<uint32_t>(what + " length");
+    if (n > kMaxString)
+      throw Bad{what + " claims " + std::to_string(n) + " bytes, above the 1 MiB limit"};
+    std::string s(n, '\0');
+    bytes(s.data(), n, what);
+    return s;
+  }
+
+  void skip(uint64_t n, const std::string& what) {
+    need(n, what);
+    seek(pos_ + n);
+  }
+
+  void seek(uint64_t p) {
+    in_.seekg(static_cast<std::streamoff>(p));
+    pos_ = p;
+  }
+
+ private:
+  void need(uint64_t n, const std::string& what) const {
+    if (n > end_ - pos_)
+      throw Bad{what + " claims " + std::to_string(n) + " bytes at offset " + std::to_string(pos_) +
+                " but only " + std::to_string(end_ - pos_) + " remain"};
+  }
+  void bytes(char* dst, uint64_t n, const std::string& what) {
+    need(n, what);
+    in_.read(dst, static_cast<std::streamsize>(n));
+    if (!in_) throw Bad{"cannot read " + what + " at offset " + std::to_string(pos_)};
+    pos_ += n;
+  }
+
+  std::ifstream& in_;
+  uint64_t end_, size_;
+  uint64_t pos_ = 0;
+};
+
+// A metadata map: count, then (name, type name, size, value) per entry.
+void check_metadata(Reader& r, const std::string& where) {
+  const int32_t count = r.read<int32_t>(where + " metadata count");
+  if (count < 0) throw Bad{where + " metadata count is negative"};
+  for (int32_t i = 0; i < count; ++i) {
+    const std::string entry = where + " metadata entry " + std::to_string(i + 1);
+    r.string(entry + " name");
+    r.string(entry + " type");
+    r.skip(r.read<uint32_t>(entry + " size"), entry + " value");
+  }
+}
+
+// The file version, or 0 for a file without grid offsets (a stream: only its header is checked).
+uint32_t check_header(Reader& r) {
+  if (r.read<int64_t>("the magic number") != kMagic) throw Bad{"not an OpenVDB file (bad magic number)"};
+  const uint32_t version = r.read<uint32_t>("the file version");
+  if (version < kOldestVersion || version > kNewestVersion)
+    throw Bad{"file format version " + std::to_string(version) + " is not supported (" +
+              std::to_string(kOldestVersion) + " to " + std::to_string(kNewestVersion) + ")"};
+  r.skip(8, "the library version");
+  const bool offsets = r.read<char>("the grid-offsets flag") != 0;
+  if (version < 222) r.skip(1, "the compression flag");  // per grid from version 222 on
+  r.skip(36, "the file UUID");
+  check_metadata(r, "file");
+  return offsets ? version : 0;
+}
+
+// One grid descriptor (name, type, parent, three offsets) and the grid's own metadata.
+void check_grid(Reader& r, uint32_t version, int index) {
+  const std::string where = "grid " + std::to_string(index + 1);
+  r.string(where + " name");
+  r.string(where + " type");
+  r.string(where + " instance parent");
+  const int64_t grid = r.read<int64_t>(where + " offset");
+  const int64_t block = r.read<int64_t>(where + " data offset");
+  const int64_t end = r.read<int64_t>(where + " end offset");
+  const auto inside = [&](int64_t x) { return x >= 0 && static_cast<uint64_t>(x) <= r.size(); };
+  if (!inside(grid) || !inside(block) || !inside(end) || static_cast<uint64_t>(grid) < r.pos() ||
+      grid > block || block > end)
+    throw Bad{where + " offsets " + std::to_string(grid) + ", " + std::to_string(block) + ", " +
+              std::to_string(end) + " are not ordered inside the file of " +
+              std::to_string(r.size()) + " bytes"};
+  r.seek(static_cast<uint64_t>(grid));
+  r.set_end(static_cast<uint64_t>(block));
+  if (version >= 222) {
+    const uint32_t compression = r.read<uint32_t>(where + " compression flags");
+    if (compression & ~kKnownCompression)
+      throw Bad{where + " has unknown compression flags " + std::to_string(compression)};
+  }
+  check_metadata(r, where);
+  r.set_end(r.size());
+  r.seek(static_cast<uint64_t>(end));
+}
+
+}  // namespace
+
+std::string vdb_structure_problem(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return "cannot open the file";
+  const std::streamoff size = in.tellg();
+  if (size < 0) return "cannot read the file size";
+  in.seekg(0);
+  Reader r(in, static_cast<uint64_t>(size));
+  try {
+    const uint32_t version = check_header(r);
+    if (version == 0) return "";
+    const int32_t grids = r.read<int32_t>("the grid count");
+    if (grids < 0 || static_cast<uint64_t>(grids) > r.size() / 36)  // 36: smallest descriptor
+      return "the grid count " + std::to_string(grids) + " does not fit the file";
+    for (int32_t i = 0; i < grids; ++i) check_grid(r, version, i);
+  } catch (const Bad& b) {
+    return b.what;
+  }
+  return "";
+}
+
+}  // namespace femto

@@ -1,0 +1,136 @@
+// Regression tests for hostile .vdb files (docs/RELIABILITY.md): far-apart voxels, corrupt bytes
+// and truncation are InputErrors naming the file; none may crash or allocate the box.
+#include <catch2/catch.hpp>
+
+#include <climits>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "media/vdb_structure.h"
+#include "media/volume_data.h"
+#include "run_femto.h"
+#include "temp_dir.h"
+
+#ifndef FEMTO_SOURCE_DIR
+#error "FEMTO_SOURCE_DIR must be defined by the build"
+#endif
+
+using namespace femto;
+using Catch::Matchers::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A density grid of single voxels at the given VDB index x coordinates.
+std::string sparse_volume(const fs::path& dir, const std::vector<int>& xs, double voxel_mm = 1) {
+  VdbGridSpec s;
+  s.name = "density";
+  s.voxel_mm = Vec3(voxel_mm);
+  for (int x : xs) s.voxels.push_back({{x, 0, 0}, 1.0f});
+  const std::string path = (dir / "sparse.vdb").string();
+  write_vdb(path, {s});
+  return path;
+}
+
+// The InputError message of loading `file`, or "" when it loads.
+std::string load_error(const std::string& file, uint64_t max_bytes = 16ull << 30) {
+  VdbMediumDesc d;
+  d.file = file;
+  d.max_dense_bytes = max_bytes;
+  try {
+    load_volume(d, "scene.json", "/media/m");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string example_volume() { return std::string(FEMTO_SOURCE_DIR) + "/data/volumes/cloud.vdb"; }
+
+// cloud.vdb with bit `mask` of byte `at` flipped (or cut to `at` bytes when mask is 0).
+std::string damaged(const fs::path& dir, size_t at, unsigned mask) {
+  std::string bytes = test::read_file(example_volume());
+  if (mask == 0)
+    bytes.resize(at);
+  else
+    bytes[at] = static_cast<char>(bytes[at] ^ static_cast<char>(mask));
+  const std::string path = (dir / "damaged.vdb").string();
+  test::write_file(path, bytes);
+  return path;
+}
+
+}  // namespace
+
+// Was: SIGSEGV: the box size x_max - x_min + 1 overflowed int to 0 cells, densify wrote via null.
+TEST_CASE("voxels at INT_MIN and INT_MAX are refused by 64-bit box arithmetic", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  const std::string msg = load_error(sparse_volume(tmp.dir, {INT_MIN, INT_MAX}));
+  CHECK_THAT(msg, Contains("sparse.vdb") && Contains("4294967296 x 1 x 1") && Contains("2^30 cells"));
+  // A single voxel at INT_MAX is a 1-cell box: it loads (the fill loop must not overflow) when
+  // its world position is inside the bounds, and is refused cleanly when not.
+  CHECK(load_error(sparse_volume(tmp.dir, {INT_MAX}, 1e-3)) == "");
+  CHECK_THAT(load_error(sparse_volume(tmp.dir, {INT_MAX})), Contains("beyond +-1e9 mm"));
+}
+
+// Was: an 8 GB allocation for a 19 KB file (a box just under the old 2^31-cell limit).
+TEST_CASE("far-apart voxels are refused before the dense box is allocated", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  const std::string file = sparse_volume(tmp.dir, {-1000000000, 1000000000});
+  CHECK(fs::file_size(file) < 100000);
+  CHECK_THAT(load_error(file), Contains("2000000001 x 1 x 1") && Contains("2^30 cells"));
+  // A box within the cell limit but above the memory --max-memory leaves for volumes.
+  const std::string mid = sparse_volume(tmp.dir, {0, 99999999});
+  CHECK_THAT(load_error(mid, 64ull << 20), Contains("left by --max-memory"));
+}
+
+// Was: std::bad_alloc from OpenVDB's reader, exit 1 without naming the file.
+TEST_CASE("a corrupt size inside the grid data is bad input naming the file", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  CHECK_THAT(load_error(damaged(tmp.dir, 3530, 0x04)),
+             Contains("/media/m/file: ") && Contains("damaged.vdb") && Contains("cannot read the file"));
+}
+
+// Was: OpenVDB trusting lengths in the header and metadata (gigabyte allocations, reads past
+// the end). Our own bounded check names the problem first.
+TEST_CASE("corrupt headers, metadata sizes and truncation are caught by the structure check", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  CHECK(vdb_structure_problem(example_volume()).empty());
+  CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 1, 0x01)), Contains("magic"));
+  CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x9a, 0x40)), Contains("metadata entry"));
+  CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x6f, 0x10)), Contains("offsets"));
+  CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 100, 0)), Contains("remain"));
+  CHECK_THAT(load_error(damaged(tmp.dir, 0x9a, 0x40)), Contains("damaged.vdb: corrupt or unsupported"));
+}
+
+// Every single-bit flip in the header, descriptors and metadata either loads or is an
+// InputError: none may crash the process or escape as another exception.
+TEST_CASE("bit flips across the structure of an example volume never crash", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  int refused = 0;
+  for (size_t at = 0; at < 0x160; ++at) {
+    INFO("byte " << at);
+    const std::string msg = load_error(damaged(tmp.dir, at, 0x08));
+    if (!msg.empty()) {
+      CHECK_THAT(msg, Contains("damaged.vdb"));
+      ++refused;
+    }
+  }
+  CHECK(refused > 50);
+}
+
+// The same through the command: exit 2 and one line, never a signal.
+TEST_CASE("femto info on a corrupt volume exits 2 naming the file", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  damaged(tmp.dir, 3530, 0x04);
+  test::write_file(tmp.dir / "scene.json", R"({
+    "camera": {"position": [0, 0, 400], "look_at": [0, 0, 0], "resolution": [8, 8]},
+    "time": {"bin_width": 10, "bins": 10},
+    "media": {"cloud": {"type": "vdb", "file": "damaged.vdb", "sigma_t_scale": 0.08}},
+    "medium": "cloud",
+    "lights": [{"type": "point", "position": [0, 0, 300], "intensity": 10}]})");
+  const test::Run r = test::run_femto({"info", "scene.json"}, tmp.dir);
+  CHECK(r.code == 2);
+  CHECK_THAT(r.err, Contains("damaged.vdb") && Contains("/media/cloud/file"));
+}
