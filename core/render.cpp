@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/pixel_sampler.h"
 #include "core/progress.h"
 #include "core/reconstruction.h"
 
@@ -39,7 +40,9 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
       static_cast<uint64_t>(y) * static_cast<uint64_t>(camera.width()) + static_cast<uint64_t>(x);
   auto trace_sample = [&](int s) {
     Rng rng = Rng::for_sample(opt.seed, pixel, static_cast<uint64_t>(s));
-    const double fx = x + rng.uniform(), fy = y + rng.uniform();
+    double dx, dy;
+    pixel_offset(opt.seed, pixel, static_cast<uint64_t>(s), dx, dy);
+    const double fx = x + dx, fy = y + dy;
     acc.sample = s;
     integrator.trace(camera.generate_ray(fx, fy), rng, acc, st);
   };

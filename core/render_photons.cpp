@@ -10,6 +10,7 @@
 
 #include "core/integrators/photon_map.h"
 #include "core/integrators/ppm_schedule.h"
+#include "core/pixel_sampler.h"
 #include "core/progress.h"
 #include "core/render.h"
 
@@ -80,7 +81,9 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
               const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
               acc.reset(axis.bins);
               Rng rng = Rng::for_sample(opt.seed, p, static_cast<uint64_t>(pass));
-              const double fx = x + rng.uniform(), fy = y + rng.uniform();
+              double dx, dy;
+              pixel_offset(opt.seed, p, static_cast<uint64_t>(pass), dx, dy);
+              const double fx = x + dx, fy = y + dy;
               integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, &gather);
               double* dst = bins.data() + p * stride;
               for (size_t i = 0; i < stride; ++i) dst[i] += acc.bins[i];

@@ -1,0 +1,233 @@
+// femto-bench-caustics: equal-time error on the caustic under the default scene's glass sphere.
+// Three estimators: camera paths with the spot light replaced by a small emissive sphere of the
+// same radiant intensity (camera paths cannot reach a spot light through glass at all), light
+// tracing, and camera paths + transient progressive photon mapping. Each is compared with a long
+// light-tracing reference of its own scene over a crop of floor pixels around the caustic that
+// see no glass (light tracing cannot see through glass, so its reference is complete there).
+// Reports relative RMSE of the steady crop and of the crop's time bins at (nearly) equal wall
+// time, plus the equal-time error ratios.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/default_scene.h"
+#include "core/render.h"
+#include "core/scene_loader.h"
+
+using namespace femto;
+
+namespace {
+
+struct Options {
+  double seconds = 20;       ///< wall-time budget per estimator
+  double ref_paths = 2e8;    ///< light paths of each reference
+  int threads = 2;
+  int x0 = 96, y0 = 136, x1 = 160, y1 = 180;  ///< crop (pixels, end exclusive)
+  uint64_t seed = 7;
+};
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown";
+}
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// The default scene with its spot light replaced by an emissive sphere of radius r at the same
+/// place, of the same radiant intensity I: a Lambertian sphere has I = Le pi r^2 in every direction.
+SceneDesc sphere_emitter_scene(const SceneDesc& spot, double r) {
+  SceneDesc d = spot;
+  const LightDesc l = d.lights.front();
+  d.lights.clear();
+  ShapeDesc s;
+  s.type = ShapeDesc::Type::Sphere;
+  s.center = l.position;
+  s.radius = r;
+  s.emissive = true;
+  s.emission = l.intensity / (3.14159265358979323846 * r * r);
+  s.pulse = l.pulse;
+  s.material.type = MaterialDesc::Type::Diffuse;
+  s.material.albedo = RGB(0.0);
+  d.shapes.push_back(s);
+  return d;
+}
+
+/// Crop pixels whose camera rays (centre and corners) miss the glass sphere.
+std::vector<int> crop_pixels(const Scene& scene, const Options& o, const ShapeDesc& glass) {
+  std::vector<int> px;
+  const Camera& cam = scene.camera();
+  for (int y = o.y0; y < o.y1; ++y)
+    for (int x = o.x0; x < o.x1; ++x) {
+      bool sees_glass = false;
+      for (const auto& c : {std::pair<double, double>{0.5, 0.5}, {0, 0}, {1, 0}, {0, 1}, {1, 1}}) {
+        const Ray r = cam.generate_ray(x + c.first, y + c.second);
+        const Vec3 oc = r.o - glass.center;
+        const double b = dot(oc, r.d), cc = dot(oc, oc) - glass.radius * glass.radius;
+        sees_glass = sees_glass || (b * b - cc > 0 && -b + std::sqrt(b * b - cc) > 0);
+      }
+      if (!sees_glass) px.push_back(y * cam.width() + x);
+    }
+  return px;
+}
+
+struct Errors {
+  double steady = 0, transient = 0;  ///< relative RMSE: RMSE over the crop / mean of the reference
+};
+
+/// A reference as the mean of two independent films (their difference bounds its own error).
+struct Reference {
+  std::vector<double> steady, transient;
+  int bins = 0;
+};
+
+Reference mean_of(const TransientFilm& a, const TransientFilm& b) {
+  Reference r;
+  r.bins = a.bins();
+  const size_t ns = static_cast<size_t>(a.width()) * static_cast<size_t>(a.height()) * 3;
+  const size_t nt = ns * static_cast<size_t>(a.bins());
+  for (size_t i = 0; i < ns; ++i) r.steady.push_back(0.5 * (static_cast<double>(a.steady()[i]) + b.steady()[i]));
+  for (size_t i = 0; i < nt; ++i)
+    r.transient.push_back(0.5 * (static_cast<double>(a.transient()[i]) + b.transient()[i]));
+  return r;
+}
+
+Errors errors(const float* steady, const float* transient, const Reference& ref, const std::vector<int>& px,
+              double scale = 1.0) {
+  const int T = ref.bins;
+  double se_s = 0, se_t = 0, m_s = 0, m_t = 0;
+  for (int p : px)
+    for (int c = 0; c < 3; ++c) {
+      const size_t i = static_cast<size_t>(p) * 3 + static_cast<size_t>(c);
+      const double d = scale * steady[i] - ref.steady[i];
+      se_s += d * d;
+      m_s += ref.steady[i];
+      for (int t = 0; t < T; ++t) {
+        const size_t k = (static_cast<size_t>(p) * static_cast<size_t>(T) + static_cast<size_t>(t)) * 3 +
+                         static_cast<size_t>(c);
+        const double e = scale * transient[k] - ref.transient[k];
+        se_t += e * e;
+        m_t += ref.transient[k];
+      }
+    }
+  const double n = 3.0 * static_cast<double>(px.size());
+  return {std::sqrt(se_s / n) / (m_s / n), std::sqrt(se_t / (n * T)) / (m_t / (n * T))};
+}
+
+RenderResult run(const Scene& scene, IntegratorKind kind, int64_t work, const Options& o, uint64_t seed) {
+  RenderOptions opt;
+  opt.integrator = kind;
+  opt.spp = kind == IntegratorKind::Light ? 1 : static_cast<int>(std::max<int64_t>(1, work));
+  opt.light_paths = kind == IntegratorKind::Light ? work : 0;
+  opt.photons = scene.desc().integrator.photons;
+  opt.threads = o.threads;
+  opt.seed = seed;
+  opt.quiet = true;
+  return render(scene, opt);
+}
+
+/// Work (spp, passes or light paths) that takes about o.seconds, from a short calibration run.
+int64_t work_for_budget(const Scene& scene, IntegratorKind kind, const Options& o) {
+  const int64_t pixels = static_cast<int64_t>(scene.camera().width()) * scene.camera().height();
+  const int64_t probe = kind == IntegratorKind::Light ? 4 * pixels : 4;
+  const double t0 = now_s();
+  run(scene, kind, probe, o, 999);
+  const double dt = now_s() - t0;
+  return std::max<int64_t>(1, static_cast<int64_t>(static_cast<double>(probe) * o.seconds / dt));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "femto-bench-caustics: %s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--seconds") o.seconds = std::atof(next().c_str());
+    else if (a == "--ref-paths") o.ref_paths = std::atof(next().c_str());
+    else if (a == "--threads") o.threads = std::atoi(next().c_str());
+    else if (a == "--seed") o.seed = std::strtoull(next().c_str(), nullptr, 10);
+    else if (a == "--help") {
+      std::printf("Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S]\n");
+      return 0;
+    } else {
+      std::fprintf(stderr, "femto-bench-caustics: unknown option %s\n", a.c_str());
+      return 2;
+    }
+  }
+  std::printf("femto-bench-caustics: CPU %s, %d threads, %.0f s per estimator, references of %.3g light paths\n",
+              cpu_model().c_str(), o.threads, o.seconds, o.ref_paths);
+  const SceneDesc spot_desc = load_scene_string(default_scene_json(), "<default scene>", ".");
+  const ShapeDesc* glass = nullptr;
+  for (const ShapeDesc& s : spot_desc.shapes)
+    if (s.material.type == MaterialDesc::Type::Dielectric) glass = &s;
+  const Scene spot(spot_desc);
+  const Scene sphere(sphere_emitter_scene(spot_desc, 2.0));
+  const std::vector<int> px = crop_pixels(spot, o, *glass);
+  std::printf("crop x [%d, %d) y [%d, %d): %zu floor pixels that see no glass\n", o.x0, o.x1, o.y0, o.y1, px.size());
+
+  std::printf("references (light tracing, two halves each)...\n");
+  std::fflush(stdout);
+  double t0 = now_s();
+  auto reference = [&](const Scene& scene, uint64_t seed, const char* name) {
+    const auto half = static_cast<int64_t>(o.ref_paths / 2);
+    const RenderResult a = run(scene, IntegratorKind::Light, half, o, seed);
+    const RenderResult b = run(scene, IntegratorKind::Light, half, o, seed + 1);
+    const Reference r = mean_of(a.film, b.film);
+    // The mean of two halves has half the variance of one: its error is RMSE(a - b) / 2.
+    const Reference b_only = mean_of(b.film, b.film);
+    const Errors e = errors(a.film.steady(), a.film.transient(), b_only, px);
+    std::printf("  %s: relative RMSE of the reference itself: steady %.4f, transient %.4f\n", name, e.steady / 2,
+                e.transient / 2);
+    return r;
+  };
+  const Reference ref_spot = reference(spot, o.seed + 100, "spot scene");
+  const Reference ref_sphere = reference(sphere, o.seed + 200, "sphere-emitter scene");
+  std::printf("references took %.0f s\n", now_s() - t0);
+
+  struct Case {
+    const char* name;
+    const Scene* scene;
+    IntegratorKind kind;
+    const Reference* ref;
+  };
+  const Case cases[] = {{"path (sphere emitter r = 2 mm)", &sphere, IntegratorKind::Path, &ref_sphere},
+                        {"light tracing", &spot, IntegratorKind::Light, &ref_spot},
+                        {"path + photons", &spot, IntegratorKind::Photons, &ref_spot}};
+  std::printf("\n%-32s %14s %9s %13s %16s %22s\n", "estimator", "work", "seconds", "steady rRMSE",
+              "transient rRMSE", "equal-time transient");
+  double base_steady = 0, base_transient = 0;
+  for (const Case& c : cases) {
+    const int64_t work = work_for_budget(*c.scene, c.kind, o);
+    t0 = now_s();
+    const RenderResult r = run(*c.scene, c.kind, work, o, o.seed);
+    const double secs = now_s() - t0;
+    const Errors e = errors(r.film.steady(), r.film.transient(), *c.ref, px);
+    // Variance falls as 1 / time: scale each error to the budget before taking ratios.
+    const double scale = std::sqrt(secs / o.seconds);
+    const double steady_eq = e.steady * scale, transient_eq = e.transient * scale;
+    if (c.kind == IntegratorKind::Path) base_steady = steady_eq, base_transient = transient_eq;
+    std::printf("%-32s %14lld %9.1f %13.4f %16.4f %12.4f (%5.1fx)\n", c.name, static_cast<long long>(work), secs,
+                e.steady, e.transient, transient_eq, base_transient / transient_eq);
+    std::printf("%-32s %14s %9s %13s %16s steady %.4f (%5.1fx)\n", "", "", "", "", "", steady_eq,
+                base_steady / steady_eq);
+    std::fflush(stdout);
+  }
+  std::printf("\nwork: spp (path), passes of 1 spp + photons (path + photons), light paths (light tracing)\n");
+  return 0;
+}
