@@ -6,6 +6,7 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/render.h"
 #include "core/scene_loader.h"
 #include "media/volume_data.h"
 
@@ -134,6 +135,9 @@ int cmd_info(const std::vector<std::string>& argv, const std::string&) {
               s.time_mode == TimeMode::Camera ? "camera" : "unwarp");
   std::printf("render: %d spp, max_depth %d, seed %llu\n", s.integrator.spp, s.integrator.max_depth,
               static_cast<unsigned long long>(s.integrator.seed));
+  std::string why;
+  const IntegratorKind kind = resolve_integrator(s, s.integrator.kind, why);
+  std::printf("integrator: %s (%s)\n", integrator_name(kind), why.c_str());
 
   int count[4] = {0, 0, 0, 0}, emissive = 0;
   for (const ShapeDesc& sh : s.shapes) {
