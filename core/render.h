@@ -1,5 +1,6 @@
 #pragma once
 // Renders a scene into a transient film with oneTBB over image tiles.
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -92,7 +93,13 @@ struct RenderMemory {
   uint64_t per_thread = 0;    ///< per-thread pixel accumulators, all threads
   uint64_t integrator = 0;    ///< photon pass or light-splat batch
   uint64_t outputs = 0;       ///< buffers while the outputs are written
-  uint64_t total() const { return film + sums + per_thread + integrator + outputs; }
+  /// The largest of: rendering (sums, per-thread and integrator buffers), building the film from
+  /// the sums, writing the outputs from the film (the sums are freed by then).
+  uint64_t peak() const {
+    const uint64_t rendering = sums + per_thread + integrator, building = sums + per_thread + film,
+                   writing = film + outputs;
+    return std::max(rendering, std::max(building, writing));
+  }
 };
 RenderMemory render_memory(int width, int height, int bins, const RenderOptions& options, int threads,
                            bool kernel, int first_pass_spp, bool multipart_frames);
