@@ -346,3 +346,19 @@ TEST_CASE("cli: the memory estimate is within 10% of the measured peak", "[resum
   CHECK(peak > 0.9 * estimate);
   CHECK(peak < 1.1 * estimate);
 }
+
+// Catches: femto diffusion ignoring SIGTERM (killed without outputs) or exiting with 130.
+TEST_CASE("cli: diffusion stops cleanly on SIGTERM with exit code 143", "[resume]") {
+  TempDir tmp("femto_resume_cli");
+  const pid_t pid = spawn_femto({"diffusion", "--photons", "1e12", "--threads", "1", "--out", "d"}, tmp.dir);
+  REQUIRE(pid > 0);
+  // Its estimate of the run time is printed once the first batches are traced.
+  for (int i = 0; i < 5000 && read_file(tmp.dir / "bg_stderr.txt").find("photons") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ::kill(pid, SIGTERM);
+  CHECK(wait_femto(pid) == 143);
+  const json run = read_json(tmp.dir / "d" / "summary.json");
+  CHECK(run.at("stopped_early") == "SIGTERM");
+  CHECK(run.at("photons_traced").get<double>() < 1e12);
+}
