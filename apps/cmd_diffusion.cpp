@@ -63,7 +63,8 @@ const char* kDiffusionHelp =
     "  --photons N        photons, 2..1e12, e.g. 1e6 (default 1e6); the run time estimated after\n"
     "                     the first batches is printed\n"
     "  --max-seconds S    stop after about S seconds and write the photons traced so far;\n"
-    "                     Ctrl-C does the same (exit code 130), a second Ctrl-C aborts\n"
+    "                     Ctrl-C or SIGTERM does the same (exit code 130 or 143), a second\n"
+    "                     signal aborts\n"
     "  --seed S           random seed, integer >= 0; the same seed gives bit-identical output for\n"
     "                     any thread count (default 1)\n"
     "  --threads N        worker threads, 0 = all cores (default 0)\n"
@@ -75,11 +76,15 @@ const char* kDiffusionHelp =
     "fluence.png and distance.png (see docs/diffusion.md).\n";
 
 
-// Ctrl-C ends the run after the current round of photons; the results so far are written.
+// Ctrl-C or SIGTERM ends the run after the current round of photons; the results so far are
+// written and the exit code is 130 (SIGINT) or 143 (SIGTERM).
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) {
+std::atomic<int> g_signal{0};
+extern "C" void on_interrupt(int sig) {
+  g_signal.store(sig);
   g_interrupted.store(true);
-  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C aborts at once
+  std::signal(SIGINT, SIG_DFL);  // a second signal aborts at once
+  std::signal(SIGTERM, SIG_DFL);
 }
 
 // The smallest time bin and shell: their widths divide the tallies (a 1e-300 ps window would
@@ -268,9 +273,11 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
   g_interrupted.store(false);
   setup.stop = &g_interrupted;
   const auto previous = std::signal(SIGINT, on_interrupt);
+  const auto previous_term = std::signal(SIGTERM, on_interrupt);
   const diffusion::DiffusionResult result =
       transport ? diffusion::simulate(setup, *transport) : diffusion::simulate(setup);
   std::signal(SIGINT, previous);
+  std::signal(SIGTERM, previous_term);
   const bool interrupted = result.stopped_early && g_interrupted.load();
   const diffusion::Analysis analysis = diffusion::analyse(setup, result, threshold);
   diffusion::ReportOptions opt;
@@ -284,7 +291,7 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
              {"photons_requested", setup.photons},
              {"photons_traced", result.photons},
              {"stopped_early", !result.stopped_early ? nlohmann::json(nullptr)
-                               : interrupted         ? nlohmann::json("interrupted (Ctrl-C)")
+                               : interrupted         ? nlohmann::json(g_signal.load() == SIGTERM ? "SIGTERM" : "interrupted (Ctrl-C)")
                                                      : nlohmann::json("--max-seconds")}};
   const std::vector<std::string> files = diffusion::write_report(setup, result, analysis, opt);
 
@@ -315,7 +322,7 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
                    static_cast<unsigned long long>(result.photons),
                    static_cast<unsigned long long>(setup.photons));
   }
-  return interrupted ? 130 : 0;
+  return interrupted ? 128 + (g_signal.load() == SIGTERM ? SIGTERM : SIGINT) : 0;
 }
 }  // namespace
 

@@ -1,13 +1,24 @@
 // `femto render`: loads a scene (or the built-in one), renders it and writes the outputs.
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <optional>
+#include <thread>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/stop_signals.h"
+#include "core/checkpoint.h"
+#include "core/io/sha256.h"
+#include "core/memory_usage.h"
+#include "core/output_folder.h"
 #include "core/default_scene.h"
 #include "core/error.h"
 #include "core/integrators/photon_map.h"
@@ -67,10 +78,21 @@ const char* kRenderHelp =
     "  --frames MODE      per-bin EXR frames: files (frames/*.exr, default), multipart\n"
     "                     (one transient.exr with a part per bin) or none\n"
     "  --no-previews      skip the PNG previews (steady.png, frames.png)\n"
-    "  --max-memory SIZE  refuse to render when the film needs more than SIZE (e.g. 2G);\n"
-    "                     default 75% of physical memory\n"
+    "  --max-memory SIZE  refuse to render when it needs more than SIZE (e.g. 2G): film,\n"
+    "                     sums, buffers and volumes; default 75% of physical memory\n"
+    "  --checkpoint       write DIR/checkpoint.bin (DIR = --out) every 60 s, atomically, and\n"
+    "                     into the partial output when stopped, for --resume\n"
+    "  --checkpoint-every S  seconds between checkpoints (0: after every pass); implies\n"
+    "                     --checkpoint\n"
+    "  --resume DIR       continue the render checkpointed in DIR (same scene and options,\n"
+    "                     any --threads): the result has the same bits as an uninterrupted\n"
+    "                     run; writes to DIR unless --out is given; keeps checkpointing\n"
     "  --quiet            no progress or summary on stderr\n"
     "  --help             this help\n"
+    "\n"
+    "Ctrl-C or SIGTERM: the current pass is finished and a complete result for the samples\n"
+    "done is written (render.json: \"complete\": false), exit code 130 or 143; a second\n"
+    "signal aborts at once and leaves the output folder as it was.\n"
     "\n"
     "Outputs (see docs/outputs.md): steady.exr, frames/*.exr, peak_time.exr, transient.npy\n"
     "(float32, shape (H, W, T, 3)), before_window.exr, after_window.exr, steady.png,\n"
@@ -157,7 +179,56 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why, cons
 }  // namespace
 
 namespace {
+const char* sampling_name(DistanceSampling s) {
+  const char* names[] = {"mfp", "time_uniform", "mis"};
+  return names[static_cast<int>(s)];
+}
+
+/// Everything that decides the bits of a render, for checkpoints: a resume must match it.
+nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc& desc, IntegratorKind kind,
+                                  const RenderOptions& opt) {
+  const ReconstructionDesc& r = desc.reconstruction;
+  const PhotonDesc& pd = opt.photons;
+  nlohmann::json media = nlohmann::json::array();
+  for (const MediumDesc& m : desc.media)
+    media.push_back({{"name", m.name},
+                     {"distance_sampling", sampling_name(m.sampling)},
+                     {"connection_sampling", static_cast<int>(m.connection)},
+                     {"direction_sampling", static_cast<int>(m.direction)}});
+  return {{"femto_version", FEMTO_VERSION},
+          {"femto_build", FEMTO_GIT_DESCRIBE},
+          {"scene_sha256", sha256_hex(scene_text)},
+          {"settings",
+           {{"spp", opt.spp},
+            {"seed", opt.seed},
+            {"max_depth", opt.max_depth},
+            {"integrator", integrator_name(kind)},
+            {"light_paths", kind == IntegratorKind::Light ? opt.light_paths : 0},
+            {"photons",
+             kind != IntegratorKind::Photons
+                 ? nlohmann::json(nullptr)
+                 : nlohmann::json{{"per_pass", pd.per_pass},
+                                  {"radius", pd.radius},
+                                  {"bandwidth_ps", pd.bandwidth_ps},
+                                  {"alpha", pd.alpha},
+                                  {"beta_t", pd.beta_t},
+                                  {"kernel", static_cast<int>(pd.kernel)}}},
+            {"reconstruction",
+             {{"type", r.type == TemporalFilter::Kind::Kernel ? "kernel" : "histogram"},
+              {"kernel", static_cast<int>(r.kernel)},
+              {"alpha", r.alpha},
+              {"knn", r.knn},
+              {"first_pass_spp", r.first_pass_spp},
+              {"bandwidth_ps", r.bandwidth_ps},
+              {"onset_reflection", r.onset_reflection}}},
+            {"media", media},
+            {"film", {desc.camera.width, desc.camera.height, desc.time.bins}}}}};
+}
+
 int cmd_render(const std::vector<std::string>& argv, const std::string& command_line) {
+  // Before any thread exists: SIGINT/SIGTERM go to one waiting thread (apps/stop_signals.h).
+  // Until the render starts, a signal aborts at once (nothing has been written yet).
+  stop_signals::start();
   cli::Args args("femto render", argv);
   std::string scene_path;
   std::optional<int> spp, max_depth;
@@ -177,6 +248,10 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   std::string photon_flag;  // the first photon-only flag given, for the error message
   int threads = 0;
   OutputOptions out;
+  bool out_given = false;
+  bool checkpoint = false;
+  double checkpoint_every = 60;
+  std::string resume_dir;
   bool quiet = false;
   uint64_t max_memory = cli::physical_memory_bytes() / 4 * 3;
   while (!args.done()) {
@@ -257,6 +332,15 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     } else if (a == "--out") {
       out.dir = args.value();
       if (out.dir.empty()) args.fail("expects a folder", "");
+      out_given = true;
+    } else if (a == "--checkpoint") {
+      checkpoint = true;
+    } else if (a == "--checkpoint-every") {
+      checkpoint_every = args.number_in(0.0, 1e9, false, false, "in [0, 1e9] s");
+      checkpoint = true;
+    } else if (a == "--resume") {
+      resume_dir = args.value();
+      if (resume_dir.empty()) args.fail("expects the folder of the render to continue", "");
     } else if (a == "--frames") {
       const std::string v = args.value();
       if (v == "files") out.frames = OutputOptions::Frames::Files;
@@ -335,32 +419,110 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   opt.quiet = quiet;
   const CameraDesc& cam = desc.camera;
   const TimeAxis axis = desc.time;
+  const bool kernel_film = rec.type == TemporalFilter::Kind::Kernel;
   const uint64_t film_bytes = TransientFilm::memory_bytes(cam.width, cam.height, axis.bins);
   if (film_bytes > max_memory)
     throw InputError("film needs " + cli::format_bytes(film_bytes) + " (" + std::to_string(cam.width) +
                      " x " + std::to_string(cam.height) + " pixels x " + std::to_string(axis.bins) +
                      " bins x RGB float32), more than --max-memory " + cli::format_bytes(max_memory) +
                      ": lower the resolution or the number of bins, or raise --max-memory");
-  // Light tracing and photons sum every pixel over the whole render in double precision, and a
-  // photon pass may keep every photon it emits.
-  const uint64_t pixel_bins = static_cast<uint64_t>(cam.width) * static_cast<uint64_t>(cam.height) *
-                              (static_cast<uint64_t>(axis.bins) + 2) * 3;
-  uint64_t extra_bytes = kind == IntegratorKind::Path ? 0 : pixel_bins * sizeof(double);
-  if (kind == IntegratorKind::Photons) extra_bytes += photon_pass_bytes(pd.per_pass);
-  if (film_bytes + extra_bytes > max_memory)
-    throw InputError("render needs " + cli::format_bytes(film_bytes + extra_bytes) + " (film " +
-                     cli::format_bytes(film_bytes) + ", integrator buffers " + cli::format_bytes(extra_bytes) +
-                     "), more than --max-memory " + cli::format_bytes(max_memory) +
+  // Everything the render allocates beside the scene: the film, the per-pixel double sums kept
+  // between passes, per-thread buffers, a photon pass or a light-splat batch, and the buffers of
+  // writing the outputs (core/render.h, render_memory).
+  const int hardware_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads_used = threads > 0 ? std::min(threads, hardware_threads) : hardware_threads;
+  const RenderMemory mem = render_memory(cam.width, cam.height, axis.bins, opt, threads_used, kernel_film,
+                                         rec.first_pass_spp, out.frames == OutputOptions::Frames::Multipart);
+  const uint64_t render_bytes = mem.peak();
+  if (render_bytes > max_memory)
+    throw InputError("render needs " + cli::format_bytes(render_bytes) + " (film " + cli::format_bytes(mem.film) +
+                     ", double-precision sums " + cli::format_bytes(mem.sums) + ", integrator buffers " +
+                     cli::format_bytes(mem.integrator + mem.per_thread) + "), more than --max-memory " +
+                     cli::format_bytes(max_memory) +
                      ": lower the resolution, the number of bins or photons per pass, or raise --max-memory");
-  // Volumes share --max-memory with the film; the renderer keeps a second copy of their grids.
-  const uint64_t left_for_volumes = max_memory > film_bytes + extra_bytes ? max_memory - film_bytes - extra_bytes : 0;
+  // Volumes share --max-memory with the render; the renderer keeps a second copy of their grids.
+  const uint64_t left_for_volumes = max_memory > render_bytes ? max_memory - render_bytes : 0;
   for (MediumDesc& m : desc.media) m.vdb.max_dense_bytes = left_for_volumes / 2;
+
+  // Checkpoint and resume: the fingerprint holds everything that decides the bits.
+  const nlohmann::json fingerprint = render_fingerprint(scene_text, desc, kind, opt);
+  if (!resume_dir.empty() && !out_given) out.dir = resume_dir;
+  if (!resume_dir.empty()) checkpoint = true;  // a resumed render stays resumable
+  std::optional<Checkpoint> resumed;
+  if (!resume_dir.empty()) {
+    const std::string path = resume_dir + "/checkpoint.bin";
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+      throw InputError("--resume " + clip(resume_dir, 200) +
+                       ": no checkpoint.bin there (the render finished, or ran without --checkpoint)");
+    resumed = read_checkpoint(path);
+    const std::string diff = fingerprint_difference(resumed->fingerprint, fingerprint);
+    if (!diff.empty())
+      throw InputError("--resume " + clip(resume_dir, 200) +
+                       ": the checkpoint was made with different settings (" + diff +
+                       "); resume with the same scene file and options");
+  }
+  // The output folder is checked before the (possibly long) scene build: a foreign or
+  // unwritable --out is bad input.
+  {
+    std::error_code ec;
+    if (std::filesystem::exists(out.dir, ec)) {
+      if (!std::filesystem::is_directory(out.dir, ec))
+        throw InputError("--out " + clip(out.dir, 200) + ": exists and is not a folder");
+      bool is_femto = false;
+      const std::string foreign = foreign_entry(out.dir, is_femto);
+      if (!foreign.empty())
+        throw InputError("--out " + clip(out.dir, 200) + ": the folder holds '" + clip(foreign) +
+                         "', which is not part of a femto render " +
+                         (is_femto ? "there" : "(no render.json written by femto)") +
+                         "; femto replaces the whole folder, so give an empty or new folder, or move the file away");
+    }
+  }
   if (!quiet)
     std::fprintf(stderr, "femto: %s: %d x %d pixels, %d bins of %.4g ps from %.4g ps, %d spp; film memory %s\n",
                  desc.source.c_str(), cam.width, cam.height, axis.bins, axis.bin_width_ps, axis.t_start_ps,
                  opt.spp, cli::format_bytes(film_bytes).c_str());
 
   const Scene scene(std::move(desc));
+  // The estimate of the peak: what is resident now (program, scene, volumes; or the highest so
+  // far, if loading peaked higher) plus what the render will allocate.
+  const uint64_t baseline_rss = current_rss_bytes();
+  const uint64_t estimate = std::max(peak_rss_bytes(), baseline_rss + render_bytes);
+  if (estimate > max_memory && baseline_rss > 0)
+    throw InputError("render needs about " + cli::format_bytes(estimate) + " (scene and program " +
+                     cli::format_bytes(baseline_rss) + ", render " + cli::format_bytes(render_bytes) +
+                     "), more than --max-memory " + cli::format_bytes(max_memory) +
+                     ": lower the resolution, the number of bins or the volumes' size, or raise --max-memory");
+
+  // Outputs go to a staging folder beside --out, swapped in at the end (core/output_folder.h).
+  OutputFolder folder(out.dir, checkpoint);
+  stop_signals::on_abort([&folder] { folder.discard(); });
+  struct AbortReset {
+    ~AbortReset() { stop_signals::on_abort(nullptr); }
+  } abort_reset;
+  OutputOptions staged = out;
+  staged.dir = folder.staging();
+
+  opt.stop = &stop_signals::requested();
+  if (resumed) opt.resume = &resumed->state;
+  const auto start_time = std::chrono::steady_clock::now();
+  auto last_checkpoint = start_time;
+  bool wrote_final_checkpoint = false;
+  opt.after_pass = [&](const RenderState& state, bool last) {
+    const auto now = std::chrono::steady_clock::now();
+    const bool stopping = last && state.units_done < state.units_total;
+    if (!checkpoint) return;
+    if (stopping) {  // into the partial output, beside the result it continues
+      std::lock_guard<std::mutex> lock(folder.mutex());
+      write_checkpoint(folder.staging() + "/checkpoint.bin", fingerprint, state);
+      wrote_final_checkpoint = true;
+    } else if (!last && std::chrono::duration<double>(now - last_checkpoint).count() >= checkpoint_every) {
+      std::lock_guard<std::mutex> lock(folder.mutex());
+      write_checkpoint(folder.checkpoint_path(), fingerprint, state);
+      last_checkpoint = std::chrono::steady_clock::now();
+    }
+  };
+  stop_signals::defer(quiet ? "" : "finishing the current pass, then writing the results (again to abort)");
   RenderResult result = render(scene, opt);
   const PathStats& st = result.stats;
   const uint64_t film_nonfinite = result.film.zero_nonfinite();  // outputs stay finite
@@ -429,13 +591,42 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"photon_gathers", st.photon_gathers}};
   info["timing"] = {{"render_seconds", result.wall_seconds},
                     {"paths_per_second", result.wall_seconds > 0 ? static_cast<double>(st.paths) / result.wall_seconds : 0.0}};
+  const int stop_signal = stop_signals::signal_number();
+  info["complete"] = result.complete;
+  info["progress"] = {{"complete", result.complete},
+                      {"unit", result.unit},
+                      {"units_done", result.units_done},
+                      {"units_total", result.units_total},
+                      {"spp_done", result.spp_done},
+                      {"sessions", result.sessions},
+                      {"stopped_by", result.complete ? nlohmann::json(nullptr)
+                                     : stop_signal == SIGTERM ? nlohmann::json("SIGTERM")
+                                                              : nlohmann::json("SIGINT")}};
+  if (kind == IntegratorKind::Light) info["progress"]["light_paths_done"] = result.light_paths;
+  if (kernel_film && !result.complete)
+    info["progress"]["rows_done"] = std::min<int64_t>(cam.height, result.units_done * 16);
+  info["checkpoint"] = {{"enabled", checkpoint},
+                        {"every_seconds", checkpoint_every},
+                        {"resumed_from", resume_dir.empty() ? nlohmann::json(nullptr) : nlohmann::json(resume_dir)},
+                        {"file", wrote_final_checkpoint ? nlohmann::json("checkpoint.bin") : nlohmann::json(nullptr)}};
+  info["memory"] = {{"estimate_bytes", estimate},
+                    {"baseline_rss_bytes", baseline_rss},
+                    {"render_bytes", render_bytes},
+                    {"breakdown",
+                     {{"film", mem.film},
+                      {"sums", mem.sums},
+                      {"per_thread", mem.per_thread},
+                      {"integrator", mem.integrator},
+                      {"outputs", mem.outputs}}},
+                    {"max_memory_bytes", max_memory},
+                    {"peak_rss_bytes", 0}};
   info["energy"] = {{"in_window", rgb_json(result.film.total_steady())},
                     {"before_window", rgb_json(result.film.total_before())},
                     {"after_window", rgb_json(result.film.total_after())},
                     {"note", "sums over pixels; after_window only counts contributions of paths "
                              "still alive (paths stop once they pass the window end)"}};
-  const std::vector<std::string> files =
-      write_outputs(result.film, out, info, result.final_bandwidth_ps);
+  const std::vector<std::string> files = write_outputs(result.film, staged, info, result.final_bandwidth_ps);
+  folder.commit();
   if (!quiet) {
     std::fprintf(stderr, "femto: %llu paths in %s (%.3g paths/s, %d threads)\n",
                  static_cast<unsigned long long>(st.paths), format_duration(result.wall_seconds).c_str(),
@@ -453,7 +644,12 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       std::fprintf(stderr, "femto: warning: %llu film values overflowed float32 and were set to 0\n",
                    static_cast<unsigned long long>(film_nonfinite));
     std::fprintf(stderr, "femto: results in %s/ (%s)\n", out.dir.c_str(), file_list(files).c_str());
+    if (!result.complete)
+      std::fprintf(stderr, "femto: stopped early: %lld of %lld %s done (render.json: \"complete\": false)%s\n",
+                   static_cast<long long>(result.units_done), static_cast<long long>(result.units_total), result.unit,
+                   wrote_final_checkpoint ? "; continue with --resume" : "");
   }
+  if (!result.complete) return 128 + (stop_signal ? stop_signal : SIGINT);
   return 0;
 }
 }  // namespace

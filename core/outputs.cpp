@@ -11,6 +11,8 @@
 #include "core/io/exr.h"
 #include "core/io/npy.h"
 #include "core/io/png.h"
+#include "core/io/sha256.h"
+#include "core/memory_usage.h"
 #include "core/io/tonemap.h"
 
 namespace femto {
@@ -27,8 +29,10 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
                    const std::vector<float>& bandwidth_ps) {
   const fs::path dir(opt.dir);
   std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw RuntimeError(opt.dir + ": cannot create the output folder: " + ec.message());
+  if (!fs::is_directory(dir, ec)) {  // normally the staging folder (core/output_folder.h), made before rendering
+    fs::create_directories(dir, ec);
+    if (ec) throw RuntimeError(opt.dir + ": cannot create the output folder: " + ec.message());
+  }
   const int W = film.width(), H = film.height(), T = film.bins();
   const TimeAxis& axis = film.axis();
   const std::vector<std::pair<std::string, std::string>> attrs = {
@@ -56,7 +60,7 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
   }
 
   if (opt.frames == OutputOptions::Frames::Files) {
-    fs::create_directories(dir / "frames", ec);
+    fs::create_directory(dir / "frames", ec);  // not recursive: never recreates a removed staging folder
     if (ec) throw RuntimeError((dir / "frames").string() + ": cannot create folder: " + ec.message());
     for (int t = 0; t < T; ++t) {
       const std::vector<float> f = film.frame(t);
@@ -108,6 +112,23 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
   }
   files.push_back("render.json");
   info["outputs"] = files;
+  // Every file with its size and SHA-256 (render.json itself excepted), frames one by one.
+  nlohmann::json listing = nlohmann::json::array();
+  auto list = [&](const std::string& name) {
+    const std::string path = path_of(name);
+    listing.push_back({{"name", name}, {"bytes", fs::file_size(path)}, {"sha256", sha256_file(path)}});
+  };
+  for (const auto& f : files) {
+    const std::string name = f.get<std::string>();
+    if (name == "render.json") continue;
+    if (name == "frames/") {
+      for (int t = 0; t < T; ++t) list(frame_file_name(axis, t));
+    } else {
+      list(name);
+    }
+  }
+  info["files"] = listing;
+  if (info.contains("memory") && info["memory"].is_object()) info["memory"]["peak_rss_bytes"] = peak_rss_bytes();
   write_text_atomically(path_of("render.json"), info.dump(2) + "\n");
   return files.get<std::vector<std::string>>();
 }

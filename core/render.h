@@ -1,6 +1,9 @@
 #pragma once
 // Renders a scene into a transient film with oneTBB over image tiles.
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -9,6 +12,8 @@
 #include "core/scene.h"
 
 namespace femto {
+
+struct RenderState;
 
 struct RenderOptions {
   IntegratorKind integrator = IntegratorKind::Path;  ///< resolved (never Auto here)
@@ -19,6 +24,42 @@ struct RenderOptions {
   int threads = 0;       ///< 0: all hardware threads
   int max_depth = 1000;
   bool quiet = false;    ///< no progress on stderr
+
+  // Passes, interruption and resume. A render runs in passes (camera paths, histogram film: a
+  // block of samples for every pixel; kernel film: a band of tile rows with all their samples;
+  // light tracing: a batch of chunks; photons: one photon pass). The result does not depend on
+  // how the work is cut into passes, so a resumed render gives the same bits.
+  /// Checked after every pass: when set, the render stops there and returns what it has
+  /// (RenderResult::complete = false). At least one pass always runs.
+  const std::atomic<bool>* stop = nullptr;
+  /// Called after every pass with the state a resumed render would continue from; `last` is true
+  /// for the final pass (the render is complete or stopping).
+  std::function<void(const RenderState& state, bool last)> after_pass;
+  /// Continue from this state (moved from); it must come from a render with the same scene and
+  /// options (the caller checks that: core/checkpoint.h).
+  RenderState* resume = nullptr;
+  /// Work units per pass (samples, tile rows, chunks); 0: sized so that a pass takes about
+  /// `pass_seconds`. Photon passes are always one photon pass.
+  int64_t units_per_pass = 0;
+  double pass_seconds = 1.0;
+};
+
+/// Everything a render continues from between passes (and in a checkpoint).
+struct RenderState {
+  IntegratorKind integrator = IntegratorKind::Path;
+  bool kernel = false;         ///< camera paths with the kernel film (units are tile rows)
+  int64_t units_done = 0;      ///< samples per pixel, tile rows, light chunks or photon passes done
+  int64_t units_total = 0;
+  int stride = 0;              ///< doubles per pixel: (bins + 2) x 3
+  /// Per pixel: bins x RGB sums over the samples done, then before-window and after-window RGB.
+  std::vector<double> sums;
+  std::vector<float> bandwidth_ps;  ///< kernel film: each finished pixel's final bandwidth
+  PathStats stats;
+  double seconds = 0;          ///< render time so far (all sessions)
+  int sessions = 0;            ///< runs that contributed (1 + resumes)
+  // Photon mapping report so far.
+  double photon_radius_last = 0, photon_bandwidth_last_ps = 0;
+  uint64_t photon_max_stored = 0, photon_peak_bytes = 0;
 };
 
 struct RenderResult {
@@ -37,7 +78,31 @@ struct RenderResult {
     uint64_t peak_photon_bytes = 0;  ///< largest photon list + grid of one pass
   } photons;
   int64_t light_paths = 0;  ///< light tracing: paths traced
+  /// False when the render stopped early (RenderOptions::stop): the film holds the samples done.
+  bool complete = true;
+  int64_t units_done = 0, units_total = 0;
+  const char* unit = "samples per pixel";  ///< what the units count
+  int64_t spp_done = 0;  ///< samples per pixel done (kernel film: in the finished rows)
+  int sessions = 1;
 };
+
+/// Memory of the buffers a render allocates on top of the loaded scene, bytes.
+struct RenderMemory {
+  uint64_t film = 0;          ///< the float32 film (built at the end)
+  uint64_t sums = 0;          ///< per-pixel double sums kept between passes
+  uint64_t per_thread = 0;    ///< per-thread pixel accumulators, all threads
+  uint64_t integrator = 0;    ///< photon pass or light-splat batch
+  uint64_t outputs = 0;       ///< buffers while the outputs are written
+  /// The largest of: rendering (sums, per-thread and integrator buffers), building the film from
+  /// the sums, writing the outputs from the film (the sums are freed by then).
+  uint64_t peak() const {
+    const uint64_t rendering = sums + per_thread + integrator, building = sums + per_thread + film,
+                   writing = film + outputs;
+    return std::max(rendering, std::max(building, writing));
+  }
+};
+RenderMemory render_memory(int width, int height, int bins, const RenderOptions& options, int threads,
+                           bool kernel, int first_pass_spp, bool multipart_frames);
 
 /// The integrator `kind` stands for in this scene: Auto becomes Photons when the scene has
 /// delta lights (point, spot, laser) and non-diffuse surfaces and the film is a histogram, else
@@ -54,6 +119,13 @@ double default_photon_bandwidth(const SceneDesc& scene);
 /// reconstruction: the whole per-pixel estimator, in double precision, before the film's float.
 void render_pixel(const Scene& scene, const VolPathIntegrator& integrator, const TemporalFilter& filter,
                   const RenderOptions& opt, int x, int y, PixelAccumulator& acc, PathStats& stats);
+
+/// Traces samples [s0, s1) of pixel (x, y) into `acc`, continuing its sums (histogram film).
+void trace_samples(const Scene& scene, const VolPathIntegrator& integrator, const RenderOptions& opt, int x,
+                   int y, int s0, int s1, PixelAccumulator& acc, PathStats& stats);
+
+/// Bytes of one light-tracing batch of splats (an estimate: a few splats per light path).
+uint64_t light_batch_bytes(uint64_t pixels);
 
 /// Traces spp paths per pixel and reconstructs time with the scene's `reconstruction`. The result is bit-identical for a given seed whatever the thread
 /// count: every sample has its own random stream and each pixel sums its samples in order.

@@ -11,6 +11,7 @@
 #include "core/integrators/light_tracer.h"
 #include "core/progress.h"
 #include "core/render.h"
+#include "core/render_passes.h"
 
 namespace femto {
 
@@ -20,35 +21,42 @@ constexpr int64_t kChunksPerBatch = 16;     // splats are binned into the film a
 constexpr uint64_t kLightStream = 0x4000000000000000ULL;  // apart from camera pixel keys
 }  // namespace
 
+uint64_t light_batch_bytes(uint64_t pixels) {
+  // About 4 splats per light path (one per vertex that sees the camera) and their sort.
+  const uint64_t splats = static_cast<uint64_t>(kChunk * kChunksPerBatch) * 4;
+  return splats * (sizeof(Splat) + sizeof(const Splat*)) + (pixels + 1) * sizeof(uint32_t) * 2;
+}
+
 RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
   const Camera& camera = scene.camera();
   const int W = camera.width(), H = camera.height();
   const TimeAxis axis = scene.desc().time;
   const TemporalFilter filter(axis, TemporalFilter::Kind::Histogram);
-  RenderResult result{TransientFilm(W, H, axis), PathStats{}, 0.0, 0, {}, {}, 0};
   const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
   const int64_t total = opt.light_paths > 0 ? opt.light_paths : static_cast<int64_t>(pixels) * opt.spp;
-  result.light_paths = total;
   // Light-path times include the emission offset: the window end plus the widest pulse spread.
   const double t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
   const LightTracer tracer(scene, opt.max_depth, t_cut);
 
-  const size_t stride = static_cast<size_t>(axis.bins) * 3;
-  std::vector<double> bins(pixels * stride, 0.0);
-  std::vector<RGB> before(pixels), after(pixels);
   const int64_t chunks = (total + kChunk - 1) / kChunk;
+  // A pass is one batch of chunks: the unit of checkpoints.
+  const int64_t batches = (chunks + kChunksPerBatch - 1) / kChunksPerBatch;
+  RenderState state = passes::start_state(opt, IntegratorKind::Light, false, pixels, axis.bins, batches);
+  const size_t stride = static_cast<size_t>(state.stride);
+  const size_t nb = static_cast<size_t>(axis.bins) * 3;
   std::vector<std::vector<Splat>> per_chunk(static_cast<size_t>(std::min(chunks, kChunksPerBatch)));
   std::vector<uint32_t> offsets(pixels + 1);
   std::vector<const Splat*> sorted;
 
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
-  result.threads = threads;
   Progress progress(static_cast<uint64_t>(total), "light paths", opt.quiet);
+  progress.add(static_cast<uint64_t>(std::min(total, state.units_done * kChunksPerBatch * kChunk)));
   tbb::enumerable_thread_specific<PathStats> stats;
   tbb::task_arena arena(threads);
   arena.execute([&] {
-    for (int64_t c0 = 0; c0 < chunks; c0 += kChunksPerBatch) {
+    while (state.units_done < batches) {
+      const auto pass_start = std::chrono::steady_clock::now();
+      const int64_t c0 = state.units_done * kChunksPerBatch;
       const int64_t c1 = std::min(chunks, c0 + kChunksPerBatch);
       tbb::parallel_for(tbb::blocked_range<int64_t>(c0, c1, 1), [&](const tbb::blocked_range<int64_t>& r) {
         PathStats& st = stats.local();
@@ -80,28 +88,46 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
           for (const Splat& s : per_chunk[static_cast<size_t>(c - c0)]) sorted[next[s.pixel]++] = &s;
       }
       tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 256), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t p = r.begin(); p != r.end(); ++p)
+        for (size_t p = r.begin(); p != r.end(); ++p) {
+          if (offsets[p] == offsets[p + 1]) continue;
+          double* px = state.sums.data() + p * stride;
+          RGB before = passes::load_rgb(px + nb), after = passes::load_rgb(px + nb + 3);
           for (uint32_t k = offsets[p]; k < offsets[p + 1]; ++k) {
             const Splat& s = *sorted[k];
-            const DepositSplit split = filter.deposit(s.t_ps, s.sigma_ps, s.value, bins.data() + p * stride);
-            if (split.before > 0) before[p] += s.value * split.before;
-            if (split.after > 0) after[p] += s.value * split.after;
+            const DepositSplit split = filter.deposit(s.t_ps, s.sigma_ps, s.value, px);
+            if (split.before > 0) before += s.value * split.before;
+            if (split.after > 0) after += s.value * split.after;
           }
+          passes::store_rgb(px + nb, before);
+          passes::store_rgb(px + nb + 3, after);
+        }
       });
+      ++state.units_done;
+      for (PathStats& s : stats) {
+        state.stats += s;
+        s = PathStats{};
+      }
+      state.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
+      const bool stopping = opt.stop && opt.stop->load();
+      if (opt.after_pass) opt.after_pass(state, stopping || state.units_done == batches);
+      if (stopping) break;
     }
   });
   progress.finish();
-  for (const PathStats& s : stats) result.stats += s;
+  per_chunk.clear();
+  per_chunk.shrink_to_fit();
+  sorted = {};
+  RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};
+  const int64_t done = std::min(total, state.units_done * kChunksPerBatch * kChunk);
+  result.light_paths = done;
+  result.complete = state.units_done == batches;
+  result.units_done = state.units_done;
+  result.units_total = batches;
+  result.unit = "batches of 65536 light paths";
+  result.spp_done = state.units_done == batches ? opt.spp : 0;
+  result.sessions = state.sessions;
   // Each pixel's mean radiance is its splat sum over all light paths.
-  const double inv = 1.0 / static_cast<double>(total);
-  for (double& b : bins) b *= inv;
-  for (size_t p = 0; p < pixels; ++p) {
-    before[p] *= inv;
-    after[p] *= inv;
-    result.film.set_pixel(static_cast<int>(p % static_cast<size_t>(W)), static_cast<int>(p / static_cast<size_t>(W)),
-                          bins.data() + p * stride, before[p], after[p], 1);
-  }
-  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (done > 0) passes::film_from_sums(result.film, state, axis.bins, 1.0 / static_cast<double>(done), 1);
   return result;
 }
 

@@ -13,6 +13,7 @@
 #include "core/pixel_sampler.h"
 #include "core/progress.h"
 #include "core/render.h"
+#include "core/render_passes.h"
 
 namespace femto {
 
@@ -21,11 +22,9 @@ constexpr int kTile = 16;
 }
 
 RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
   const Camera& camera = scene.camera();
   const int W = camera.width(), H = camera.height();
   const TimeAxis axis = scene.desc().time;
-  RenderResult result{TransientFilm(W, H, axis), PathStats{}, 0.0, 0, {}, {}, 0};
   const TemporalFilter filter(axis, TemporalFilter::Kind::Histogram);
   const VolPathIntegrator integrator(scene, filter, opt.max_depth);
   const PhotonDesc& pd = opt.photons;
@@ -36,39 +35,39 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
 
   const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
-  const size_t stride = static_cast<size_t>(axis.bins) * 3;
-  std::vector<double> bins(pixels * stride, 0.0);
-  std::vector<RGB> before(pixels), after(pixels);
+  // A pass is one photon pass (and one camera sample per pixel); the schedule's state is the
+  // pass index, so a resumed render replays it.
+  RenderState state = passes::start_state(opt, IntegratorKind::Photons, false, pixels, axis.bins, opt.spp);
+  for (int64_t i = 0; i < state.units_done; ++i) schedule.advance();
+  const size_t stride = static_cast<size_t>(state.stride);
+  const size_t nb = static_cast<size_t>(axis.bins) * 3;
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
-  result.threads = threads;
-  RenderResult::PhotonReport& rep = result.photons;
-  rep.passes = opt.spp;
-  rep.per_pass = pd.per_pass;
-  rep.radius_first = R1;
-  rep.bandwidth_first_ps = T1;
 
   Progress progress(static_cast<uint64_t>(opt.spp), "photon passes", opt.quiet);
+  progress.add(static_cast<uint64_t>(state.units_done));
   tbb::enumerable_thread_specific<PixelAccumulator> accumulators;
   tbb::enumerable_thread_specific<PathStats> stats;
-  PathStats photon_stats;
   PhotonGrid grid;
   tbb::task_arena arena(threads);
   arena.execute([&] {
-    for (int pass = 0; pass < opt.spp; ++pass) {
+    while (state.units_done < opt.spp) {
+      const auto pass_start = std::chrono::steady_clock::now();
+      const int pass = static_cast<int>(state.units_done);
+      PathStats photon_stats;
       std::vector<Photon> photons =
           trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth, photon_t_cut, photon_stats);
-      rep.max_stored_per_pass = std::max<uint64_t>(rep.max_stored_per_pass, photons.size());
+      state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());
       grid.build(std::move(photons), schedule.radius());
-      rep.peak_photon_bytes = std::max(rep.peak_photon_bytes, grid.memory_bytes());
+      state.photon_peak_bytes = std::max(state.photon_peak_bytes, grid.memory_bytes());
       PhotonGather gather;
       gather.grid = &grid;
       gather.radius = schedule.radius();
       gather.bandwidth_ps = schedule.bandwidth();
       gather.inv_emitted = 1.0 / static_cast<double>(pd.per_pass);
       gather.kernel = TemporalFilter(axis, TemporalFilter::Kind::Kernel, pd.kernel);
-      rep.radius_last = gather.radius;
-      rep.bandwidth_last_ps = gather.bandwidth_ps;
+      state.photon_radius_last = gather.radius;
+      state.photon_bandwidth_last_ps = gather.bandwidth_ps;
       // One camera sample per pixel, the same stream as sample `pass` of a path-only render.
       tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
         PixelAccumulator& acc = accumulators.local();
@@ -85,24 +84,46 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
               pixel_offset(opt.seed, p, static_cast<uint64_t>(pass), dx, dy);
               const double fx = x + dx, fy = y + dy;
               integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, &gather);
-              double* dst = bins.data() + p * stride;
-              for (size_t i = 0; i < stride; ++i) dst[i] += acc.bins[i];
-              before[p] += acc.before;
-              after[p] += acc.after;
+              double* dst = state.sums.data() + p * stride;
+              for (size_t i = 0; i < nb; ++i) dst[i] += acc.bins[i];
+              passes::store_rgb(dst + nb, passes::load_rgb(dst + nb) + acc.before);
+              passes::store_rgb(dst + nb + 3, passes::load_rgb(dst + nb + 3) + acc.after);
             }
         }
       });
       schedule.advance();
       progress.add(1);
+      ++state.units_done;
+      state.stats += photon_stats;
+      for (PathStats& s : stats) {
+        state.stats += s;
+        s = PathStats{};
+      }
+      state.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
+      const bool stopping = opt.stop && opt.stop->load();
+      if (opt.after_pass) opt.after_pass(state, stopping || state.units_done == opt.spp);
+      if (stopping) break;
     }
   });
   progress.finish();
-  for (const PathStats& s : stats) result.stats += s;
-  result.stats += photon_stats;
-  for (size_t p = 0; p < pixels; ++p)
-    result.film.set_pixel(static_cast<int>(p % static_cast<size_t>(W)), static_cast<int>(p / static_cast<size_t>(W)),
-                          bins.data() + p * stride, before[p], after[p], opt.spp);
-  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  grid = PhotonGrid();
+  RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};
+  RenderResult::PhotonReport& rep = result.photons;
+  rep.passes = static_cast<int>(state.units_done);
+  rep.per_pass = pd.per_pass;
+  rep.radius_first = R1;
+  rep.bandwidth_first_ps = T1;
+  rep.radius_last = state.photon_radius_last;
+  rep.bandwidth_last_ps = state.photon_bandwidth_last_ps;
+  rep.max_stored_per_pass = state.photon_max_stored;
+  rep.peak_photon_bytes = state.photon_peak_bytes;
+  result.complete = state.units_done == opt.spp;
+  result.units_done = state.units_done;
+  result.units_total = opt.spp;
+  result.unit = "photon passes (one camera sample per pixel each)";
+  result.spp_done = state.units_done;
+  result.sessions = state.sessions;
+  passes::film_from_sums(result.film, state, axis.bins, 1.0, static_cast<int>(state.units_done));
   return result;
 }
 

@@ -1096,11 +1096,16 @@ std::string read_scene_text(const std::string& path) {
   if (!fs::exists(path, ec)) throw InputError(name + ": scene file not found");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(name + ": cannot open scene file");
-  // Read at most one byte past the limit: /dev/zero or a pipe must not be read forever.
-  std::string text(kMaxSceneBytes + 1, '\0');
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  // Read at most one byte past the limit: /dev/zero or a pipe must not be read forever. Read in
+  // pieces, so that a small file does not cost (resident) memory for the whole limit.
+  std::string text;
+  char piece[1 << 16];
+  while (text.size() <= kMaxSceneBytes && in) {
+    const std::size_t want = std::min(sizeof piece, kMaxSceneBytes + 1 - text.size());
+    in.read(piece, static_cast<std::streamsize>(want));
+    text.append(piece, static_cast<std::size_t>(in.gcount()));
+  }
   if (in.bad()) throw InputError(name + ": cannot read scene file");
-  text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxSceneBytes)
     throw InputError(name + ": scene file is larger than the 64 MiB limit");
   return text;

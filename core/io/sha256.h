@@ -1,0 +1,31 @@
+#pragma once
+// SHA-256 (FIPS 180-4) for the file list in render.json and the integrity of checkpoints.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace femto {
+
+class Sha256 {
+ public:
+  Sha256() { reset(); }
+  void reset();
+  void update(const void* data, size_t bytes);
+  /// Finishes the hash (the object must be reset before reuse) and returns the 32-byte digest.
+  void finish(uint8_t digest[32]);
+  /// Finishes and returns the digest as 64 lowercase hex digits.
+  std::string hex();
+
+ private:
+  void block(const uint8_t* p);
+  uint32_t h_[8];
+  uint8_t buf_[64];
+  size_t used_ = 0;
+  uint64_t length_ = 0;  ///< bytes hashed so far
+};
+
+std::string sha256_hex(const std::string& bytes);
+/// Hash of a file's bytes, streamed. Throws RuntimeError naming the file when it cannot be read.
+std::string sha256_file(const std::string& path);
+
+}  // namespace femto
