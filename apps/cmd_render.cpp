@@ -628,9 +628,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   const std::vector<std::string> files = write_outputs(result.film, staged, info, result.final_bandwidth_ps);
   folder.commit();
   if (!quiet) {
-    std::fprintf(stderr, "femto: %llu paths in %s (%.3g paths/s, %d threads)\n",
-                 static_cast<unsigned long long>(st.paths), format_duration(result.wall_seconds).c_str(),
-                 info["timing"]["paths_per_second"].get<double>(), result.threads);
+    std::fprintf(stderr, "femto: %llu camera paths and %llu light paths (%s) in %s (%d threads)\n",
+                 static_cast<unsigned long long>(st.paths), static_cast<unsigned long long>(st.light_paths),
+                 integrator_name(kind), format_duration(result.wall_seconds).c_str(), result.threads);
     if (st.max_depth_hits > 0 && depth_source == "default")
       std::fprintf(stderr, "femto: warning: %llu paths reached the safety bound max_depth %d (counted in render.json)\n",
                    static_cast<unsigned long long>(st.max_depth_hits), opt.max_depth);

@@ -23,8 +23,8 @@ std::string format_duration(double seconds) {
   return buf;
 }
 
-Progress::Progress(uint64_t total, std::string label, bool quiet)
-    : total_(total), label_(std::move(label)), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {
+Progress::Progress(uint64_t total, std::string label, bool quiet, std::string unit)
+    : total_(total), label_(std::move(label)), unit_(std::move(unit)), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {
   start_ = std::chrono::steady_clock::now();
   if (!quiet_) thread_ = std::thread([this] { run(); });
 }
@@ -49,9 +49,9 @@ void Progress::print(bool final_line) {
   const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;
   const double eta = rate > 0 ? static_cast<double>(total_ - std::min(done, total_)) / rate : NAN;
   char stats[160];
-  std::snprintf(stats, sizeof stats, "%5.1f%%  %s elapsed  ETA %s  %.3g paths/s", 100.0 * frac,
+  std::snprintf(stats, sizeof stats, "%5.1f%%  %s elapsed  ETA %s  %.3g %s/s", 100.0 * frac,
                 format_duration(elapsed).c_str(), final_line ? "0.0s" : format_duration(eta).c_str(),
-                rate);
+                rate, unit_.c_str());
   if (tty_) {
     const int width = 30;
     const int filled = static_cast<int>(frac * width);

@@ -14,7 +14,8 @@ namespace femto {
 class Progress {
  public:
   /// total: work units (paths); label: shown before the bar.
-  Progress(uint64_t total, std::string label, bool quiet);
+  /// unit: what the rate counts ("paths", "passes", "photons").
+  Progress(uint64_t total, std::string label, bool quiet, std::string unit = "paths");
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
@@ -29,7 +30,7 @@ class Progress {
   void print(bool final_line);
 
   uint64_t total_;
-  std::string label_;
+  std::string label_, unit_;
   bool quiet_, tty_;
   std::atomic<uint64_t> done_{0};
   std::chrono::steady_clock::time_point start_;

@@ -44,7 +44,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
 
-  Progress progress(static_cast<uint64_t>(opt.spp), "photon passes", opt.quiet);
+  Progress progress(static_cast<uint64_t>(opt.spp), "photon passes", opt.quiet, "passes");
   progress.add(static_cast<uint64_t>(state.units_done));
   tbb::enumerable_thread_specific<PixelAccumulator> accumulators;
   tbb::enumerable_thread_specific<PathStats> stats;

@@ -62,7 +62,7 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
   bool stopped_early = false;
   std::vector<TallySums> partial(slots);
   tbb::enumerable_thread_specific<PhotonTally> tallies([&] { return PhotonTally(grid); });
-  Progress progress(N, "diffusion", setup.quiet);
+  Progress progress(N, "diffusion", setup.quiet, "photons");
   tbb::task_arena arena(threads);
   for (uint64_t first = 0; first < batches; first += slots) {
     const size_t count = static_cast<size_t>(std::min<uint64_t>(slots, batches - first));
