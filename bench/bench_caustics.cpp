@@ -24,8 +24,8 @@ using namespace femto;
 namespace {
 
 struct Options {
-  double seconds = 20;       ///< wall-time budget per estimator
-  double ref_paths = 2e8;    ///< light paths of each reference
+  double seconds = 20;     ///< wall-time budget per estimator
+  double ref_paths = 2e8;  ///< light paths of each reference
   int threads = 2;
   int x0 = 96, y0 = 136, x1 = 160, y1 = 180;  ///< crop (pixels, end exclusive)
   uint64_t seed = 7;
@@ -44,7 +44,8 @@ double now_s() {
 }
 
 /// The default scene with its spot light replaced by an emissive sphere of radius r at the same
-/// place, of the same radiant intensity I: a Lambertian sphere has I = Le pi r^2 in every direction.
+/// place, of the same radiant intensity I: a Lambertian sphere has I = Le pi r^2 in every
+/// direction.
 SceneDesc sphere_emitter_scene(const SceneDesc& spot, double r) {
   SceneDesc d = spot;
   const LightDesc l = d.lights.front();
@@ -95,14 +96,15 @@ Reference mean_of(const TransientFilm& a, const TransientFilm& b) {
   r.bins = a.bins();
   const size_t ns = static_cast<size_t>(a.width()) * static_cast<size_t>(a.height()) * 3;
   const size_t nt = ns * static_cast<size_t>(a.bins());
-  for (size_t i = 0; i < ns; ++i) r.steady.push_back(0.5 * (static_cast<double>(a.steady()[i]) + b.steady()[i]));
+  for (size_t i = 0; i < ns; ++i)
+    r.steady.push_back(0.5 * (static_cast<double>(a.steady()[i]) + b.steady()[i]));
   for (size_t i = 0; i < nt; ++i)
     r.transient.push_back(0.5 * (static_cast<double>(a.transient()[i]) + b.transient()[i]));
   return r;
 }
 
-Errors errors(const float* steady, const float* transient, const Reference& ref, const std::vector<int>& px,
-              double scale = 1.0) {
+Errors errors(const float* steady, const float* transient, const Reference& ref,
+              const std::vector<int>& px, double scale = 1.0) {
   const int T = ref.bins;
   double se_s = 0, se_t = 0, m_s = 0, m_t = 0;
   for (int p : px)
@@ -112,8 +114,9 @@ Errors errors(const float* steady, const float* transient, const Reference& ref,
       se_s += d * d;
       m_s += ref.steady[i];
       for (int t = 0; t < T; ++t) {
-        const size_t k = (static_cast<size_t>(p) * static_cast<size_t>(T) + static_cast<size_t>(t)) * 3 +
-                         static_cast<size_t>(c);
+        const size_t k =
+            (static_cast<size_t>(p) * static_cast<size_t>(T) + static_cast<size_t>(t)) * 3 +
+            static_cast<size_t>(c);
         const double e = scale * transient[k] - ref.transient[k];
         se_t += e * e;
         m_t += ref.transient[k];
@@ -123,7 +126,8 @@ Errors errors(const float* steady, const float* transient, const Reference& ref,
   return {std::sqrt(se_s / n) / (m_s / n), std::sqrt(se_t / (n * T)) / (m_t / (n * T))};
 }
 
-RenderResult run(const Scene& scene, IntegratorKind kind, int64_t work, const Options& o, uint64_t seed) {
+RenderResult run(const Scene& scene, IntegratorKind kind, int64_t work, const Options& o,
+                 uint64_t seed) {
   RenderOptions opt;
   opt.integrator = kind;
   opt.spp = kind == IntegratorKind::Light ? 1 : static_cast<int>(std::max<int64_t>(1, work));
@@ -158,20 +162,27 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--seconds") o.seconds = std::atof(next().c_str());
-    else if (a == "--ref-paths") o.ref_paths = std::atof(next().c_str());
-    else if (a == "--threads") o.threads = std::atoi(next().c_str());
-    else if (a == "--seed") o.seed = std::strtoull(next().c_str(), nullptr, 10);
+    if (a == "--seconds")
+      o.seconds = std::atof(next().c_str());
+    else if (a == "--ref-paths")
+      o.ref_paths = std::atof(next().c_str());
+    else if (a == "--threads")
+      o.threads = std::atoi(next().c_str());
+    else if (a == "--seed")
+      o.seed = std::strtoull(next().c_str(), nullptr, 10);
     else if (a == "--help") {
-      std::printf("Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S]\n");
+      std::printf(
+          "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S]\n");
       return 0;
     } else {
       std::fprintf(stderr, "femto-bench-caustics: unknown option %s\n", a.c_str());
       return 2;
     }
   }
-  std::printf("femto-bench-caustics: CPU %s, %d threads, %.0f s per estimator, references of %.3g light paths\n",
-              cpu_model().c_str(), o.threads, o.seconds, o.ref_paths);
+  std::printf(
+      "femto-bench-caustics: CPU %s, %d threads, %.0f s per estimator, references of %.3g light "
+      "paths\n",
+      cpu_model().c_str(), o.threads, o.seconds, o.ref_paths);
   const SceneDesc spot_desc = load_scene_string(default_scene_json(), "<default scene>", ".");
   const ShapeDesc* glass = nullptr;
   for (const ShapeDesc& s : spot_desc.shapes)
@@ -179,7 +190,8 @@ int main(int argc, char** argv) {
   const Scene spot(spot_desc);
   const Scene sphere(sphere_emitter_scene(spot_desc, 2.0));
   const std::vector<int> px = crop_pixels(spot, o, *glass);
-  std::printf("crop x [%d, %d) y [%d, %d): %zu floor pixels that see no glass\n", o.x0, o.x1, o.y0, o.y1, px.size());
+  std::printf("crop x [%d, %d) y [%d, %d): %zu floor pixels that see no glass\n", o.x0, o.x1, o.y0,
+              o.y1, px.size());
 
   std::printf("references (light tracing, two halves each)...\n");
   std::fflush(stdout);
@@ -192,8 +204,8 @@ int main(int argc, char** argv) {
     // The mean of two halves has half the variance of one: its error is RMSE(a - b) / 2.
     const Reference b_only = mean_of(b.film, b.film);
     const Errors e = errors(a.film.steady(), a.film.transient(), b_only, px);
-    std::printf("  %s: relative RMSE of the reference itself: steady %.4f, transient %.4f\n", name, e.steady / 2,
-                e.transient / 2);
+    std::printf("  %s: relative RMSE of the reference itself: steady %.4f, transient %.4f\n", name,
+                e.steady / 2, e.transient / 2);
     return r;
   };
   const Reference ref_spot = reference(spot, o.seed + 100, "spot scene");
@@ -206,9 +218,10 @@ int main(int argc, char** argv) {
     IntegratorKind kind;
     const Reference* ref;
   };
-  const Case cases[] = {{"path (sphere emitter r = 2 mm)", &sphere, IntegratorKind::Path, &ref_sphere},
-                        {"light tracing", &spot, IntegratorKind::Light, &ref_spot},
-                        {"path + photons", &spot, IntegratorKind::Photons, &ref_spot}};
+  const Case cases[] = {
+      {"path (sphere emitter r = 2 mm)", &sphere, IntegratorKind::Path, &ref_sphere},
+      {"light tracing", &spot, IntegratorKind::Light, &ref_spot},
+      {"path + photons", &spot, IntegratorKind::Photons, &ref_spot}};
   std::printf("\n%-32s %14s %9s %13s %16s %22s\n", "estimator", "work", "seconds", "steady rRMSE",
               "transient rRMSE", "equal-time transient");
   double base_steady = 0, base_transient = 0;
@@ -222,12 +235,15 @@ int main(int argc, char** argv) {
     const double scale = std::sqrt(secs / o.seconds);
     const double steady_eq = e.steady * scale, transient_eq = e.transient * scale;
     if (c.kind == IntegratorKind::Path) base_steady = steady_eq, base_transient = transient_eq;
-    std::printf("%-32s %14lld %9.1f %13.4f %16.4f %12.4f (%5.1fx)\n", c.name, static_cast<long long>(work), secs,
-                e.steady, e.transient, transient_eq, base_transient / transient_eq);
+    std::printf("%-32s %14lld %9.1f %13.4f %16.4f %12.4f (%5.1fx)\n", c.name,
+                static_cast<long long>(work), secs, e.steady, e.transient, transient_eq,
+                base_transient / transient_eq);
     std::printf("%-32s %14s %9s %13s %16s steady %.4f (%5.1fx)\n", "", "", "", "", "", steady_eq,
                 base_steady / steady_eq);
     std::fflush(stdout);
   }
-  std::printf("\nwork: spp (path), passes of 1 spp + photons (path + photons), light paths (light tracing)\n");
+  std::printf(
+      "\nwork: spp (path), passes of 1 spp + photons (path + photons), light paths (light "
+      "tracing)\n");
   return 0;
 }

@@ -39,7 +39,8 @@ class Camera {
   /// film as the plane at unit distance and A_pix its area per pixel: perspective W =
   /// 1 / (A_pix cos^3(theta) dist^2), orthographic W = 1 / A_pix (dist = depth along the axis).
   /// False when x is behind the sensor or projects outside the film.
-  bool connect_to(const Vec3& x, double& fx, double& fy, Vec3& w_to_sensor, double& dist, double& W) const {
+  bool connect_to(const Vec3& x, double& fx, double& fy, Vec3& w_to_sensor, double& dist,
+                  double& W) const {
     const bool persp = desc_.type == CameraDesc::Type::Perspective;
     const Vec3 v = x - desc_.position;
     const double z = dot(v, forward_);
@@ -49,7 +50,8 @@ class Camera {
     fx = (sx / half_w_ + 1.0) * 0.5 * desc_.width;
     fy = (1.0 - sy / half_h_) * 0.5 * desc_.height;
     if (!(fx >= 0 && fx < desc_.width && fy >= 0 && fy < desc_.height)) return false;
-    const double a_pix = 4.0 * half_w_ * half_h_ / (static_cast<double>(desc_.width) * desc_.height);
+    const double a_pix =
+        4.0 * half_w_ * half_h_ / (static_cast<double>(desc_.width) * desc_.height);
     if (persp) {
       dist = length(v);
       w_to_sensor = -v / dist;

@@ -35,7 +35,8 @@ LightSet::LightSet(const SceneDesc& scene) : scene_(&scene) {
         l.intensity = d.intensity;
         l.cos_cone = std::cos(d.cone_angle_deg * kPi / 180.0);
         l.cos_falloff = std::cos(d.falloff_deg * kPi / 180.0);
-        power.push_back(2.0 * kPi * (1.0 - 0.5 * (l.cos_cone + l.cos_falloff)) * d.intensity.average());
+        power.push_back(2.0 * kPi * (1.0 - 0.5 * (l.cos_cone + l.cos_falloff)) *
+                        d.intensity.average());
         break;
       }
       case LightDesc::Type::Laser:
@@ -63,7 +64,8 @@ LightSet::LightSet(const SceneDesc& scene) : scene_(&scene) {
       l.type = Light::Type::AreaMesh;
       double acc = 0.0;
       for (const auto& t : sh.triangles) {
-        acc += 0.5 * length(cross(sh.vertices[t[1]] - sh.vertices[t[0]], sh.vertices[t[2]] - sh.vertices[t[0]]));
+        acc += 0.5 * length(cross(sh.vertices[t[1]] - sh.vertices[t[0]],
+                                  sh.vertices[t[2]] - sh.vertices[t[0]]));
         l.tri_cdf.push_back(acc);
       }
       l.area = acc;
@@ -184,7 +186,8 @@ bool LightSet::sample(int i, const Vec3& x, double u1, double u2, LightSample& l
 
 namespace {
 /// Uniform point on an emitting mesh (triangle by area, then uniform in it) and its front normal.
-void sample_mesh_point(const ShapeDesc& sh, const std::vector<double>& tri_cdf, double u1, double u2, Vec3& p, Vec3& n) {
+void sample_mesh_point(const ShapeDesc& sh, const std::vector<double>& tri_cdf, double u1,
+                       double u2, Vec3& p, Vec3& n) {
   const auto it = std::upper_bound(tri_cdf.begin(), tri_cdf.end(), u1);
   const size_t t = std::min(static_cast<size_t>(it - tri_cdf.begin()), tri_cdf.size() - 1);
   const double c0 = t == 0 ? 0.0 : tri_cdf[t - 1];
@@ -199,7 +202,8 @@ void sample_mesh_point(const ShapeDesc& sh, const std::vector<double>& tri_cdf, 
 }
 }  // namespace
 
-bool LightSet::sample_emission(int i, double u1, double u2, double u3, double u4, LightEmission& e) const {
+bool LightSet::sample_emission(int i, double u1, double u2, double u3, double u4,
+                               LightEmission& e) const {
   const Light& l = lights_[static_cast<size_t>(i)];
   e.area = false;
   switch (l.type) {
@@ -212,7 +216,8 @@ bool LightSet::sample_emission(int i, double u1, double u2, double u3, double u4
       const double cos_t = 1.0 - u1 * (1.0 - l.cos_cone);
       const double sin_t = std::sqrt(std::fmax(0.0, 1.0 - cos_t * cos_t));
       const double phi = 2.0 * kPi * u2;
-      const Vec3 d = normalize(Frame(l.direction).to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t}));
+      const Vec3 d = normalize(
+          Frame(l.direction).to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t}));
       const double falloff = smoothstep(l.cos_cone, l.cos_falloff, cos_t);
       if (!(falloff > 0)) return false;
       e.ray = {l.position, d};

@@ -10,20 +10,20 @@ namespace femto {
 
 /// A light sample seen from a receiving point x.
 struct LightSample {
-  Vec3 p;              ///< point on the light
-  Vec3 wi;             ///< unit direction from x towards p
-  double dist = 0;     ///< |p - x|, mm
-  RGB Li;              ///< radiance (area lights) or irradiance normal to wi (delta lights)
-  double pdf = 0;      ///< solid-angle pdf of wi (area lights); 1 for delta lights
+  Vec3 p;           ///< point on the light
+  Vec3 wi;          ///< unit direction from x towards p
+  double dist = 0;  ///< |p - x|, mm
+  RGB Li;           ///< radiance (area lights) or irradiance normal to wi (delta lights)
+  double pdf = 0;   ///< solid-angle pdf of wi (area lights); 1 for delta lights
   bool is_delta = false;
 };
 
 /// A ray leaving a light, for light paths and photons.
 struct LightEmission {
-  Ray ray;                 ///< origin on the light, unit direction of travel
-  Vec3 n;                  ///< area lights: unit normal at the origin
-  RGB beta;                ///< flux weight: emitted intensity or radiance x cos / (pdf_pos pdf_dir)
-  RGB Le_over_pdf_pos;     ///< area lights: emitted radiance / area pdf of the origin
+  Ray ray;              ///< origin on the light, unit direction of travel
+  Vec3 n;               ///< area lights: unit normal at the origin
+  RGB beta;             ///< flux weight: emitted intensity or radiance x cos / (pdf_pos pdf_dir)
+  RGB Le_over_pdf_pos;  ///< area lights: emitted radiance / area pdf of the origin
   bool area = false;
 };
 
@@ -33,14 +33,16 @@ struct Light {
   Vec3 position, direction;
   RGB intensity, power, emission;
   double cos_cone = 0, cos_falloff = 1, radius = 0;
-  int shape = -1;                  ///< area lights: the emitting shape
-  std::vector<double> tri_cdf;     ///< area meshes: CDF over triangle areas
-  double area = 0;                 ///< area lights: total area, mm^2
+  int shape = -1;               ///< area lights: the emitting shape
+  std::vector<double> tri_cdf;  ///< area meshes: CDF over triangle areas
+  double area = 0;              ///< area lights: total area, mm^2
   PulseDesc pulse;
 };
 
 /// Point and spot lights: a single emitting point, the target of segment connections.
-inline bool is_point_like(const Light& l) { return l.type == Light::Type::Point || l.type == Light::Type::Spot; }
+inline bool is_point_like(const Light& l) {
+  return l.type == Light::Type::Point || l.type == Light::Type::Spot;
+}
 
 class LightSet {
  public:
@@ -58,7 +60,9 @@ class LightSet {
   bool sample_emission(int i, double u1, double u2, double u3, double u4, LightEmission& e) const;
   /// Light index of an emissive shape, or -1.
   int light_of_shape(int shape) const {
-    return shape >= 0 && shape < static_cast<int>(shape_light_.size()) ? shape_light_[static_cast<size_t>(shape)] : -1;
+    return shape >= 0 && shape < static_cast<int>(shape_light_.size())
+               ? shape_light_[static_cast<size_t>(shape)]
+               : -1;
   }
   /// Solid-angle pdf with which sample() would produce direction x->p on area light i
   /// (p with unit normal n on the light), not including the pick pmf.

@@ -32,8 +32,9 @@ double typical_bandwidth(const PixelAccumulator& acc, const TimeAxis& axis) {
 }
 }  // namespace
 
-void trace_samples(const Scene& scene, const VolPathIntegrator& integrator, const RenderOptions& opt, int x,
-                   int y, int s0, int s1, PixelAccumulator& acc, PathStats& st) {
+void trace_samples(const Scene& scene, const VolPathIntegrator& integrator,
+                   const RenderOptions& opt, int x, int y, int s0, int s1, PixelAccumulator& acc,
+                   PathStats& st) {
   const Camera& camera = scene.camera();
   const uint64_t pixel =
       static_cast<uint64_t>(y) * static_cast<uint64_t>(camera.width()) + static_cast<uint64_t>(x);
@@ -52,7 +53,9 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
   const TimeAxis& axis = filter.axis();
   const ReconstructionDesc& rec = scene.desc().reconstruction;
   acc.reset(axis.bins);
-  auto trace_sample = [&](int s) { trace_samples(scene, integrator, opt, x, y, s, s + 1, acc, st); };
+  auto trace_sample = [&](int s) {
+    trace_samples(scene, integrator, opt, x, y, s, s + 1, acc, st);
+  };
   if (rec.type != TemporalFilter::Kind::Kernel) {
     trace_samples(scene, integrator, opt, x, y, 0, opt.spp, acc, st);
     return;
@@ -111,7 +114,8 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
   // first pass sets its bandwidths for all later samples, so a pass is a band of tile rows with
   // all their samples.
   const int64_t total = kernel ? tiles_y : opt.spp;
-  RenderState state = passes::start_state(opt, IntegratorKind::Path, kernel, pixels, axis.bins, total);
+  RenderState state =
+      passes::start_state(opt, IntegratorKind::Path, kernel, pixels, axis.bins, total);
   const size_t S = static_cast<size_t>(state.stride);
   const size_t nb = static_cast<size_t>(axis.bins) * 3;
 
@@ -121,7 +125,8 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
   const uint64_t per_pixel_spp = static_cast<uint64_t>(opt.spp);
   Progress progress(static_cast<uint64_t>(pixels) * per_pixel_spp, "render", opt.quiet);
   auto pixels_in_rows = [&](int64_t tile_rows) {
-    return static_cast<uint64_t>(std::min<int64_t>(H, tile_rows * kTile)) * static_cast<uint64_t>(W);
+    return static_cast<uint64_t>(std::min<int64_t>(H, tile_rows * kTile)) *
+           static_cast<uint64_t>(W);
   };
   progress.add(kernel ? pixels_in_rows(state.units_done) * per_pixel_spp
                       : static_cast<uint64_t>(pixels) * static_cast<uint64_t>(state.units_done));
@@ -135,46 +140,42 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
       const int64_t u0 = state.units_done, u1 = u0 + planner.next(u0, total);
       const int tile0 = kernel ? static_cast<int>(u0) * tiles_x : 0;
       const int tile1 = kernel ? static_cast<int>(u1) * tiles_x : tiles_x * tiles_y;
-      tbb::parallel_for(tbb::blocked_range<int>(tile0, tile1, 1), [&](const tbb::blocked_range<int>& r) {
-        PixelAccumulator& acc = accumulators.local();
-        PathStats& st = stats.local();
-        for (int tile = r.begin(); tile != r.end(); ++tile) {
-          const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-          const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
-          for (int y = y0; y < y1; ++y) {
-            for (int x = x0; x < x1; ++x) {
-              const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
-              double* sums = state.sums.data() + p * S;
-              if (kernel) {
-                render_pixel(scene, integrator, filter, opt, x, y, acc, st);
-                state.bandwidth_ps[p] = static_cast<float>(typical_bandwidth(acc, axis));
-              } else {
-                // Continue the pixel's sums with samples [u0, u1).
-                acc.reset(axis.bins);
-                std::copy(sums, sums + nb, acc.bins.begin());
-                acc.before = passes::load_rgb(sums + nb);
-                acc.after = passes::load_rgb(sums + nb + 3);
-                trace_samples(scene, integrator, opt, x, y, static_cast<int>(u0), static_cast<int>(u1), acc, st);
+      tbb::parallel_for(
+          tbb::blocked_range<int>(tile0, tile1, 1), [&](const tbb::blocked_range<int>& r) {
+            PixelAccumulator& acc = accumulators.local();
+            PathStats& st = stats.local();
+            for (int tile = r.begin(); tile != r.end(); ++tile) {
+              const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+              const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
+              for (int y = y0; y < y1; ++y) {
+                for (int x = x0; x < x1; ++x) {
+                  const size_t p =
+                      static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
+                  double* sums = state.sums.data() + p * S;
+                  if (kernel) {
+                    render_pixel(scene, integrator, filter, opt, x, y, acc, st);
+                    state.bandwidth_ps[p] = static_cast<float>(typical_bandwidth(acc, axis));
+                  } else {
+                    // Continue the pixel's sums with samples [u0, u1).
+                    acc.reset(axis.bins);
+                    std::copy(sums, sums + nb, acc.bins.begin());
+                    acc.before = passes::load_rgb(sums + nb);
+                    acc.after = passes::load_rgb(sums + nb + 3);
+                    trace_samples(scene, integrator, opt, x, y, static_cast<int>(u0),
+                                  static_cast<int>(u1), acc, st);
+                  }
+                  std::copy(acc.bins.begin(), acc.bins.end(), sums);
+                  passes::store_rgb(sums + nb, acc.before);
+                  passes::store_rgb(sums + nb + 3, acc.after);
+                }
+                progress.add(static_cast<uint64_t>(x1 - x0) *
+                             (kernel ? per_pixel_spp : static_cast<uint64_t>(u1 - u0)));
               }
-              std::copy(acc.bins.begin(), acc.bins.end(), sums);
-              passes::store_rgb(sums + nb, acc.before);
-              passes::store_rgb(sums + nb + 3, acc.after);
             }
-            progress.add(static_cast<uint64_t>(x1 - x0) *
-                         (kernel ? per_pixel_spp : static_cast<uint64_t>(u1 - u0)));
-          }
-        }
-      });
+          });
       planner.done();
       state.units_done = u1;
-      for (PathStats& s : stats) {
-        state.stats += s;
-        s = PathStats{};
-      }
-      state.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
-      const bool stopping = opt.stop && opt.stop->load();
-      if (opt.after_pass) opt.after_pass(state, stopping || state.units_done == total);
-      if (stopping) break;
+      if (passes::end_pass(state, stats, pass_start, opt, total)) break;
     }
   });
   progress.finish();
@@ -200,8 +201,8 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
   return result;
 }
 
-RenderMemory render_memory(int width, int height, int bins, const RenderOptions& opt, int threads, bool kernel,
-                           int first_pass_spp, bool multipart_frames) {
+RenderMemory render_memory(int width, int height, int bins, const RenderOptions& opt, int threads,
+                           bool kernel, int first_pass_spp, bool multipart_frames) {
   RenderMemory m;
   const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
   const uint64_t B = static_cast<uint64_t>(bins);
@@ -213,7 +214,8 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
                                      (sizeof(PixelAccumulator::Held) + sizeof(double))
                                : 0;
   m.per_thread = static_cast<uint64_t>(std::max(1, threads)) * (B * 3 * sizeof(double) + held);
-  if (opt.integrator == IntegratorKind::Photons) m.integrator = photon_pass_bytes(opt.photons.per_pass);
+  if (opt.integrator == IntegratorKind::Photons)
+    m.integrator = photon_pass_bytes(opt.photons.per_pass);
   if (opt.integrator == IntegratorKind::Light) m.integrator = light_batch_bytes(pixels);
   // Writing: a frame, the peak-time image, the contact sheet's 16 frames and its 8-bit image,
   // the 8-bit preview; a multipart EXR is written from the film itself.

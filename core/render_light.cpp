@@ -16,8 +16,8 @@
 namespace femto {
 
 namespace {
-constexpr int64_t kChunk = 4096;            // light paths per task: the unit of deterministic order
-constexpr int64_t kChunksPerBatch = 16;     // splats are binned into the film after each batch
+constexpr int64_t kChunk = 4096;         // light paths per task: the unit of deterministic order
+constexpr int64_t kChunksPerBatch = 16;  // splats are binned into the film after each batch
 constexpr uint64_t kLightStream = 0x4000000000000000ULL;  // apart from camera pixel keys
 }  // namespace
 
@@ -33,7 +33,8 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
   const TimeAxis axis = scene.desc().time;
   const TemporalFilter filter(axis, TemporalFilter::Kind::Histogram);
   const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
-  const int64_t total = opt.light_paths > 0 ? opt.light_paths : static_cast<int64_t>(pixels) * opt.spp;
+  const int64_t total =
+      opt.light_paths > 0 ? opt.light_paths : static_cast<int64_t>(pixels) * opt.spp;
   // Light-path times include the emission offset: the window end plus the widest pulse spread.
   const double t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
   const LightTracer tracer(scene, opt.max_depth, t_cut);
@@ -41,7 +42,8 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
   const int64_t chunks = (total + kChunk - 1) / kChunk;
   // A pass is one batch of chunks: the unit of checkpoints.
   const int64_t batches = (chunks + kChunksPerBatch - 1) / kChunksPerBatch;
-  RenderState state = passes::start_state(opt, IntegratorKind::Light, false, pixels, axis.bins, batches);
+  RenderState state =
+      passes::start_state(opt, IntegratorKind::Light, false, pixels, axis.bins, batches);
   const size_t stride = static_cast<size_t>(state.stride);
   const size_t nb = static_cast<size_t>(axis.bins) * 3;
   std::vector<std::vector<Splat>> per_chunk(static_cast<size_t>(std::min(chunks, kChunksPerBatch)));
@@ -58,19 +60,20 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
       const auto pass_start = std::chrono::steady_clock::now();
       const int64_t c0 = state.units_done * kChunksPerBatch;
       const int64_t c1 = std::min(chunks, c0 + kChunksPerBatch);
-      tbb::parallel_for(tbb::blocked_range<int64_t>(c0, c1, 1), [&](const tbb::blocked_range<int64_t>& r) {
-        PathStats& st = stats.local();
-        for (int64_t c = r.begin(); c != r.end(); ++c) {
-          std::vector<Splat>& out = per_chunk[static_cast<size_t>(c - c0)];
-          out.clear();
-          const int64_t end = std::min(total, (c + 1) * kChunk);
-          for (int64_t i = c * kChunk; i < end; ++i) {
-            Rng rng = Rng::for_sample(opt.seed, kLightStream, static_cast<uint64_t>(i));
-            tracer.trace(rng, out, st);
-          }
-          progress.add(static_cast<uint64_t>(end - c * kChunk));
-        }
-      });
+      tbb::parallel_for(
+          tbb::blocked_range<int64_t>(c0, c1, 1), [&](const tbb::blocked_range<int64_t>& r) {
+            PathStats& st = stats.local();
+            for (int64_t c = r.begin(); c != r.end(); ++c) {
+              std::vector<Splat>& out = per_chunk[static_cast<size_t>(c - c0)];
+              out.clear();
+              const int64_t end = std::min(total, (c + 1) * kChunk);
+              for (int64_t i = c * kChunk; i < end; ++i) {
+                Rng rng = Rng::for_sample(opt.seed, kLightStream, static_cast<uint64_t>(i));
+                tracer.trace(rng, out, st);
+              }
+              progress.add(static_cast<uint64_t>(end - c * kChunk));
+            }
+          });
       // Bin the batch: a stable counting sort by pixel keeps path order within each pixel, so
       // every pixel sums its splats in the same order whatever the thread count.
       std::fill(offsets.begin(), offsets.end(), 0u);
@@ -85,32 +88,27 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
       {
         std::vector<uint32_t> next(offsets.begin(), offsets.end() - 1);
         for (int64_t c = c0; c < c1; ++c)
-          for (const Splat& s : per_chunk[static_cast<size_t>(c - c0)]) sorted[next[s.pixel]++] = &s;
+          for (const Splat& s : per_chunk[static_cast<size_t>(c - c0)])
+            sorted[next[s.pixel]++] = &s;
       }
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 256), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t p = r.begin(); p != r.end(); ++p) {
-          if (offsets[p] == offsets[p + 1]) continue;
-          double* px = state.sums.data() + p * stride;
-          RGB before = passes::load_rgb(px + nb), after = passes::load_rgb(px + nb + 3);
-          for (uint32_t k = offsets[p]; k < offsets[p + 1]; ++k) {
-            const Splat& s = *sorted[k];
-            const DepositSplit split = filter.deposit(s.t_ps, s.sigma_ps, s.value, px);
-            if (split.before > 0) before += s.value * split.before;
-            if (split.after > 0) after += s.value * split.after;
-          }
-          passes::store_rgb(px + nb, before);
-          passes::store_rgb(px + nb + 3, after);
-        }
-      });
+      tbb::parallel_for(
+          tbb::blocked_range<size_t>(0, pixels, 256), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t p = r.begin(); p != r.end(); ++p) {
+              if (offsets[p] == offsets[p + 1]) continue;
+              double* px = state.sums.data() + p * stride;
+              RGB before = passes::load_rgb(px + nb), after = passes::load_rgb(px + nb + 3);
+              for (uint32_t k = offsets[p]; k < offsets[p + 1]; ++k) {
+                const Splat& s = *sorted[k];
+                const DepositSplit split = filter.deposit(s.t_ps, s.sigma_ps, s.value, px);
+                if (split.before > 0) before += s.value * split.before;
+                if (split.after > 0) after += s.value * split.after;
+              }
+              passes::store_rgb(px + nb, before);
+              passes::store_rgb(px + nb + 3, after);
+            }
+          });
       ++state.units_done;
-      for (PathStats& s : stats) {
-        state.stats += s;
-        s = PathStats{};
-      }
-      state.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
-      const bool stopping = opt.stop && opt.stop->load();
-      if (opt.after_pass) opt.after_pass(state, stopping || state.units_done == batches);
-      if (stopping) break;
+      if (passes::end_pass(state, stats, pass_start, opt, batches)) break;
     }
   });
   progress.finish();
@@ -127,7 +125,8 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
   result.spp_done = state.units_done == batches ? opt.spp : 0;
   result.sessions = state.sessions;
   // Each pixel's mean radiance is its splat sum over all light paths.
-  if (done > 0) passes::film_from_sums(result.film, state, axis.bins, 1.0 / static_cast<double>(done), 1);
+  if (done > 0)
+    passes::film_from_sums(result.film, state, axis.bins, 1.0 / static_cast<double>(done), 1);
   return result;
 }
 

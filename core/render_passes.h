@@ -10,7 +10,9 @@
 
 namespace femto::passes {
 
-inline RGB load_rgb(const double* p) { return {p[0], p[1], p[2]}; }
+inline RGB load_rgb(const double* p) {
+  return {p[0], p[1], p[2]};
+}
 inline void store_rgb(double* p, const RGB& c) {
   p[0] = c.r;
   p[1] = c.g;
@@ -18,8 +20,8 @@ inline void store_rgb(double* p, const RGB& c) {
 }
 
 /// A fresh state, or the one to resume (checked against this render's shape).
-inline RenderState start_state(const RenderOptions& opt, IntegratorKind kind, bool kernel, size_t pixels, int bins,
-                               int64_t units_total) {
+inline RenderState start_state(const RenderOptions& opt, IntegratorKind kind, bool kernel,
+                               size_t pixels, int bins, int64_t units_total) {
   RenderState s;
   const int stride = (bins + 2) * 3;
   if (opt.resume) {
@@ -28,7 +30,9 @@ inline RenderState start_state(const RenderOptions& opt, IntegratorKind kind, bo
         s.sums.size() != pixels * static_cast<size_t>(stride) || s.units_total != units_total ||
         s.units_done < 0 || s.units_done > units_total ||
         (kernel && s.bandwidth_ps.size() != pixels))
-      throw InputError("the checkpoint's render state does not fit this render (film, integrator or length differ)");
+      throw InputError(
+          "the checkpoint's render state does not fit this render (film, integrator or length "
+          "differ)");
   } else {
     s.integrator = kind;
     s.kernel = kernel;
@@ -39,6 +43,23 @@ inline RenderState start_state(const RenderOptions& opt, IntegratorKind kind, bo
   }
   s.sessions += 1;
   return s;
+}
+
+/// Ends a pass: folds the per-thread counters into the state, adds the pass's time, hands the
+/// state to after_pass (checkpoints), and says whether a stop was requested.
+template <class ThreadStats>
+bool end_pass(RenderState& state, ThreadStats& stats,
+              std::chrono::steady_clock::time_point pass_start, const RenderOptions& opt,
+              int64_t units_total) {
+  for (PathStats& s : stats) {
+    state.stats += s;
+    s = PathStats{};
+  }
+  state.seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
+  const bool stopping = opt.stop && opt.stop->load();
+  if (opt.after_pass) opt.after_pass(state, stopping || state.units_done == units_total);
+  return stopping;
 }
 
 /// Sizes passes so that each takes about `seconds` (the first is one unit), or uses a fixed size.
@@ -53,9 +74,12 @@ class Planner {
   }
   /// After the pass: the time it took sets the next size (at most 4 times larger).
   void done() {
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double want = s > 0 ? seconds_ / s * static_cast<double>(last_) : 4.0 * static_cast<double>(last_);
-    size_ = std::max<int64_t>(1, static_cast<int64_t>(std::min(want, 4.0 * static_cast<double>(last_))));
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double want =
+        s > 0 ? seconds_ / s * static_cast<double>(last_) : 4.0 * static_cast<double>(last_);
+    size_ = std::max<int64_t>(
+        1, static_cast<int64_t>(std::min(want, 4.0 * static_cast<double>(last_))));
   }
 
  private:

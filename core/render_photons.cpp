@@ -37,7 +37,8 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
   // A pass is one photon pass (and one camera sample per pixel); the schedule's state is the
   // pass index, so a resumed render replays it.
-  RenderState state = passes::start_state(opt, IntegratorKind::Photons, false, pixels, axis.bins, opt.spp);
+  RenderState state =
+      passes::start_state(opt, IntegratorKind::Photons, false, pixels, axis.bins, opt.spp);
   for (int64_t i = 0; i < state.units_done; ++i) schedule.advance();
   const size_t stride = static_cast<size_t>(state.stride);
   const size_t nb = static_cast<size_t>(axis.bins) * 3;
@@ -55,8 +56,8 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       const auto pass_start = std::chrono::steady_clock::now();
       const int pass = static_cast<int>(state.units_done);
       PathStats photon_stats;
-      std::vector<Photon> photons =
-          trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth, photon_t_cut, photon_stats);
+      std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth,
+                                                  photon_t_cut, photon_stats);
       state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());
       grid.build(std::move(photons), schedule.radius());
       state.photon_peak_bytes = std::max(state.photon_peak_bytes, grid.memory_bytes());
@@ -69,40 +70,35 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       state.photon_radius_last = gather.radius;
       state.photon_bandwidth_last_ps = gather.bandwidth_ps;
       // One camera sample per pixel, the same stream as sample `pass` of a path-only render.
-      tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
-        PixelAccumulator& acc = accumulators.local();
-        PathStats& st = stats.local();
-        for (int tile = r.begin(); tile != r.end(); ++tile) {
-          const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-          const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
-          for (int y = y0; y < y1; ++y)
-            for (int x = x0; x < x1; ++x) {
-              const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
-              acc.reset(axis.bins);
-              Rng rng = Rng::for_sample(opt.seed, p, static_cast<uint64_t>(pass));
-              double dx, dy;
-              pixel_offset(opt.seed, p, static_cast<uint64_t>(pass), dx, dy);
-              const double fx = x + dx, fy = y + dy;
-              integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, &gather);
-              double* dst = state.sums.data() + p * stride;
-              for (size_t i = 0; i < nb; ++i) dst[i] += acc.bins[i];
-              passes::store_rgb(dst + nb, passes::load_rgb(dst + nb) + acc.before);
-              passes::store_rgb(dst + nb + 3, passes::load_rgb(dst + nb + 3) + acc.after);
+      tbb::parallel_for(
+          tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
+            PixelAccumulator& acc = accumulators.local();
+            PathStats& st = stats.local();
+            for (int tile = r.begin(); tile != r.end(); ++tile) {
+              const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+              const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
+              for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x) {
+                  const size_t p =
+                      static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
+                  acc.reset(axis.bins);
+                  Rng rng = Rng::for_sample(opt.seed, p, static_cast<uint64_t>(pass));
+                  double dx, dy;
+                  pixel_offset(opt.seed, p, static_cast<uint64_t>(pass), dx, dy);
+                  const double fx = x + dx, fy = y + dy;
+                  integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, &gather);
+                  double* dst = state.sums.data() + p * stride;
+                  for (size_t i = 0; i < nb; ++i) dst[i] += acc.bins[i];
+                  passes::store_rgb(dst + nb, passes::load_rgb(dst + nb) + acc.before);
+                  passes::store_rgb(dst + nb + 3, passes::load_rgb(dst + nb + 3) + acc.after);
+                }
             }
-        }
-      });
+          });
       schedule.advance();
       progress.add(1);
       ++state.units_done;
       state.stats += photon_stats;
-      for (PathStats& s : stats) {
-        state.stats += s;
-        s = PathStats{};
-      }
-      state.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
-      const bool stopping = opt.stop && opt.stop->load();
-      if (opt.after_pass) opt.after_pass(state, stopping || state.units_done == opt.spp);
-      if (stopping) break;
+      if (passes::end_pass(state, stats, pass_start, opt, opt.spp)) break;
     }
   });
   progress.finish();

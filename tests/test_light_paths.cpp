@@ -56,8 +56,8 @@ LightDesc point_light(const Vec3& p, double intensity) {
 }
 
 /// One film per seed with the given integrator; `work` is spp (path, photons) or light paths.
-std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kind, int64_t work, int n, uint64_t seed0,
-                                   const PhotonDesc& photons = {}) {
+std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kind, int64_t work, int n,
+                                   uint64_t seed0, const PhotonDesc& photons = {}) {
   std::vector<TransientFilm> films;
   for (int b = 0; b < n; ++b) {
     RenderOptions opt;
@@ -75,20 +75,23 @@ std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kind, int6
 
 /// Per-batch sums of the three channels over blocks of `block` x `block` pixels and groups of
 /// `group` bins: cells[c][b] for cell c of batch b.
-std::vector<std::vector<double>> cells(const std::vector<TransientFilm>& films, int block, int group) {
+std::vector<std::vector<double>> cells(const std::vector<TransientFilm>& films, int block,
+                                       int group) {
   const TransientFilm& f0 = films.front();
   const int bx = (f0.width() + block - 1) / block, by = (f0.height() + block - 1) / block;
   const int bt = (f0.bins() + group - 1) / group;
-  std::vector<std::vector<double>> out(static_cast<size_t>(bx * by * bt), std::vector<double>(films.size(), 0.0));
+  std::vector<std::vector<double>> out(static_cast<size_t>(bx * by * bt),
+                                       std::vector<double>(films.size(), 0.0));
   for (size_t b = 0; b < films.size(); ++b) {
     const float* v = films[b].transient();
     for (int y = 0; y < f0.height(); ++y)
       for (int x = 0; x < f0.width(); ++x)
         for (int t = 0; t < f0.bins(); ++t) {
-          const size_t i = ((static_cast<size_t>(y) * static_cast<size_t>(f0.width()) + static_cast<size_t>(x)) *
-                                static_cast<size_t>(f0.bins()) +
-                            static_cast<size_t>(t)) *
-                           3;
+          const size_t i =
+              ((static_cast<size_t>(y) * static_cast<size_t>(f0.width()) + static_cast<size_t>(x)) *
+                   static_cast<size_t>(f0.bins()) +
+               static_cast<size_t>(t)) *
+              3;
           const size_t c = static_cast<size_t>(((y / block) * bx + x / block) * bt + t / group);
           out[c][b] += static_cast<double>(v[i]) + v[i + 1] + v[i + 2];
         }
@@ -106,8 +109,8 @@ struct Agreement {
 
 /// Compares two estimators cell by cell: z = difference / combined standard error, over cells
 /// whose signal is at least `min_share` of the largest cell's.
-Agreement compare(const std::vector<std::vector<double>>& a, const std::vector<std::vector<double>>& b,
-                  double min_share = 0.02) {
+Agreement compare(const std::vector<std::vector<double>>& a,
+                  const std::vector<std::vector<double>>& b, double min_share = 0.02) {
   Agreement g;
   double peak = 0;
   for (const auto& c : a) peak = std::max(peak, mean_se(c).mean);
@@ -132,8 +135,9 @@ Agreement compare(const std::vector<std::vector<double>>& a, const std::vector<s
 }
 
 void require_agreement(const Agreement& g, int min_cells) {
-  INFO("cells " << g.compared << ", max |z| " << g.max_z << ", chi2 " << g.chi2 << ", relative SE of the total "
-                << g.rel_se_total << " (" << g.rel_se_a << " and " << g.rel_se_b << ")");
+  INFO("cells " << g.compared << ", max |z| " << g.max_z << ", chi2 " << g.chi2
+                << ", relative SE of the total " << g.rel_se_total << " (" << g.rel_se_a << " and "
+                << g.rel_se_b << ")");
   REQUIRE(g.compared >= min_cells);
   CHECK(g.max_z < 4.0);
   // Sum of z^2 over the cells: catches a small bias shared by many cells that no single cell shows.
@@ -170,10 +174,12 @@ SceneDesc caustic_scene(const TimeAxis& axis) {
 // Catches: a wrong sensor importance (cos^3, pixel area, distance), a missing phase or BSDF factor
 // in the camera connection, medium time taken from distance instead of OPL, or time added in the
 // wrong place: light tracing and camera paths estimate the same bins only if all are right.
-TEST_CASE("light tracing agrees with camera paths: fog with a point light and diffuse walls", "[light-paths]") {
-  // The fog fills a box (kept clear of the walls: coincident faces are ambiguous) that leaves out the camera: a camera inside a medium gives light tracing
-  // infinite variance (1 / d^2 connections from vertices next to the sensor), as a point light
-  // does for collision next-event estimation (hence segment connections here).
+TEST_CASE("light tracing agrees with camera paths: fog with a point light and diffuse walls",
+          "[light-paths]") {
+  // The fog fills a box (kept clear of the walls: coincident faces are ambiguous) that leaves out
+  // the camera: a camera inside a medium gives light tracing infinite variance (1 / d^2 connections
+  // from vertices next to the sensor), as a point light does for collision next-event estimation
+  // (hence segment connections here).
   const SceneDesc d = load_scene_string(R"({
     "camera": { "type": "perspective", "position": [0, 30, 140], "look_at": [0, 25, 0], "fov": 45,
                 "resolution": [16, 12] },
@@ -188,7 +194,8 @@ TEST_CASE("light tracing agrees with camera paths: fog with a point light and di
         "material": { "type": "diffuse", "albedo": 0.5 } }
     ],
     "lights": [ { "type": "point", "position": [10, 40, -10], "intensity": 1000 } ]
-  })", "fog box", ".");
+  })",
+                                        "fog box", ".");
   const Scene scene(d);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 128, 24, 100), 4, 3);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 100000, 24, 200), 4, 3);
@@ -197,17 +204,18 @@ TEST_CASE("light tracing agrees with camera paths: fog with a point light and di
 
 // Catches: the emitter vertex (an area light seen directly), cosines at diffuse vertices, or the
 // one-sided emission of area lights handled differently on the two sides.
-TEST_CASE("light tracing agrees with camera paths: a diffuse room with an area light and a point light",
-          "[light-paths]") {
+TEST_CASE(
+    "light tracing agrees with camera paths: a diffuse room with an area light and a point light",
+    "[light-paths]") {
   SceneDesc d;
   d.source = "room";
   d.camera = perspective({0, 40, 150}, {0, 35, 0}, 50, 16, 12);
   d.time = axis_of(300, 100, 10);
-  d.shapes.push_back(quad({-50, 0, 50}, {100, 0, 0}, {0, 0, -100}, diffuse(0.6)));    // floor
-  d.shapes.push_back(quad({-50, 0, -50}, {100, 0, 0}, {0, 80, 0}, diffuse(0.6)));     // back
-  d.shapes.push_back(quad({-50, 0, 50}, {0, 0, -100}, {0, 80, 0}, diffuse(0.4)));     // left
-  d.shapes.push_back(quad({50, 0, -50}, {0, 0, 100}, {0, 80, 0}, diffuse(0.4)));      // right
-  ShapeDesc lamp = quad({-15, 79, -15}, {30, 0, 0}, {0, 0, 30}, MaterialDesc{});       // faces down
+  d.shapes.push_back(quad({-50, 0, 50}, {100, 0, 0}, {0, 0, -100}, diffuse(0.6)));  // floor
+  d.shapes.push_back(quad({-50, 0, -50}, {100, 0, 0}, {0, 80, 0}, diffuse(0.6)));   // back
+  d.shapes.push_back(quad({-50, 0, 50}, {0, 0, -100}, {0, 80, 0}, diffuse(0.4)));   // left
+  d.shapes.push_back(quad({50, 0, -50}, {0, 0, 100}, {0, 80, 0}, diffuse(0.4)));    // right
+  ShapeDesc lamp = quad({-15, 79, -15}, {30, 0, 0}, {0, 0, 30}, MaterialDesc{});    // faces down
   lamp.emissive = true;
   lamp.emission = RGB(2.0);
   lamp.material = diffuse(0.0);
@@ -222,7 +230,8 @@ TEST_CASE("light tracing agrees with camera paths: a diffuse room with an area l
 // Catches: light paths and camera paths scattering off rough surfaces differently: the
 // importance-mode BSDF (no 1/eta^2 on refraction), rough refraction seen by the camera through
 // connections from the exit vertex, and the two-sided rough conductor.
-TEST_CASE("light tracing agrees with camera paths through rough glass and off rough metal", "[light-paths]") {
+TEST_CASE("light tracing agrees with camera paths through rough glass and off rough metal",
+          "[light-paths]") {
   SceneDesc d;
   d.source = "rough";
   d.camera = perspective({0, 30, 120}, {0, 20, 0}, 45, 16, 12);
@@ -251,7 +260,8 @@ TEST_CASE("light tracing agrees with camera paths through rough glass and off ro
 
 // Catches: emission sampling of spot lights (cone, falloff) and lasers (beam radius, flux), and
 // pulses (Gaussian width, offset) on the light side: both lights with pulses, in fog over a floor.
-TEST_CASE("light tracing agrees with camera paths for a spot light and a laser with pulses", "[light-paths]") {
+TEST_CASE("light tracing agrees with camera paths for a spot light and a laser with pulses",
+          "[light-paths]") {
   const SceneDesc d = load_scene_string(R"({
     "camera": { "type": "perspective", "position": [0, 40, 130], "look_at": [0, 15, 0], "fov": 45,
                 "resolution": [16, 12] },
@@ -269,7 +279,8 @@ TEST_CASE("light tracing agrees with camera paths for a spot light and a laser w
       { "type": "laser", "position": [20, 70, -10], "direction": [-0.2, -1, 0.1], "radius": 4,
         "power": 300, "pulse": { "fwhm": 30 } }
     ]
-  })", "spot and laser", ".");
+  })",
+                                        "spot and laser", ".");
   const Scene scene(d);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 320, 24, 1600), 4, 3);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 60000, 24, 1700), 4, 3);
@@ -278,14 +289,16 @@ TEST_CASE("light tracing agrees with camera paths for a spot light and a laser w
 
 // Catches: light paths that do not follow the per-voxel index (time from the wrong eta, or the
 // voxel medium's albedo and extinction ignored on the light side).
-TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-voxel eta", "[light-paths]") {
+TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-voxel eta",
+          "[light-paths]") {
   TempDir tmp("femto_light_paths");
   const int n = 12;
   DenseGrid density(n, n, n, 0.0f), eta(n, n, n, 1.0f);
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {
-        const size_t i = (static_cast<size_t>(z) * n + static_cast<size_t>(y)) * n + static_cast<size_t>(x);
+        const size_t i =
+            (static_cast<size_t>(z) * n + static_cast<size_t>(y)) * n + static_cast<size_t>(x);
         density.v[i] = 0.01f + 0.004f * static_cast<float>(x + y);
         eta.v[i] = 1.0f + 0.05f * static_cast<float>(z);
       }
@@ -318,7 +331,8 @@ TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-vox
 // Catches: photons stored or gathered with the wrong normalisation or time, the caustic partition
 // dropping or double-counting paths (camera paths cannot reach light -> glass -> floor from a
 // point light at all, so both estimators here see caustics through different techniques).
-TEST_CASE("camera paths + photons agree with light tracing on a caustic from a point light", "[light-paths]") {
+TEST_CASE("camera paths + photons agree with light tracing on a caustic from a point light",
+          "[light-paths]") {
   const Scene scene(caustic_scene(axis_of(250, 60, 8)));
   PhotonDesc pd;
   pd.per_pass = 40000;
@@ -332,7 +346,8 @@ TEST_CASE("camera paths + photons agree with light tracing on a caustic from a p
 // Catches: camera paths still counting light -> glass -> floor -> camera when photons are on
 // (double counting), or dropping other paths: an emissive sphere behind glass is reachable by
 // camera paths alone, so path-only and path + photons must agree.
-TEST_CASE("path-only and path + photons agree for an emissive sphere behind glass", "[light-paths]") {
+TEST_CASE("path-only and path + photons agree for an emissive sphere behind glass",
+          "[light-paths]") {
   SceneDesc d;
   d.source = "partition";
   d.camera = perspective({0, 60, 90}, {0, 0, 0}, 50, 16, 12);
@@ -367,13 +382,15 @@ TEST_CASE("progressive radius and bandwidth follow the schedule", "[light-paths]
     const double ratio = (j + alpha) / (j + 1.0);
     volume *= ratio;
     CHECK(s.radius() * s.radius() * s.bandwidth() == Approx(volume).epsilon(1e-12));
-    CHECK(s.radius() * s.radius() / before_r2 == Approx(std::pow(ratio, 1 - beta_t)).epsilon(1e-12));
+    CHECK(s.radius() * s.radius() / before_r2 ==
+          Approx(std::pow(ratio, 1 - beta_t)).epsilon(1e-12));
     CHECK(s.bandwidth() / before_T == Approx(std::pow(ratio, beta_t)).epsilon(1e-12));
   }
   // The product telescopes to Gamma(n + alpha) / (Gamma(1 + alpha) Gamma(n + 1)) ~ n^(alpha - 1).
   const double n = 200;
   CHECK(volume / 40.0 ==
-        Approx(std::exp(std::lgamma(n + alpha) - std::lgamma(1 + alpha) - std::lgamma(n + 1))).epsilon(1e-9));
+        Approx(std::exp(std::lgamma(n + alpha) - std::lgamma(1 + alpha) - std::lgamma(n + 1)))
+            .epsilon(1e-9));
 }
 
 // Catches: photon-mapping bias that does not go away: at a caustic's sharp edge the disc kernel
@@ -382,7 +399,9 @@ TEST_CASE("progressive radius and bandwidth follow the schedule", "[light-paths]
 TEST_CASE("the photon estimate's bias shrinks as passes go on", "[light-paths]") {
   const Scene scene(caustic_scene(axis_of(0, 2000, 1)));
   const int W = 12;
-  auto pixel = [&](const TransientFilm& f, int x, int y) { return f.steady()[3 * static_cast<size_t>(y * W + x) + 1]; };
+  auto pixel = [&](const TransientFilm& f, int x, int y) {
+    return f.steady()[3 * static_cast<size_t>(y * W + x) + 1];
+  };
   const auto ref_films = batches(scene, IntegratorKind::Light, 100000, 12, 1100);
   // The caustic's peak: the brightest 2 x 2 block of the unbiased light-tracing answer.
   int bx = 0, by = 0;
@@ -390,11 +409,13 @@ TEST_CASE("the photon estimate's bias shrinks as passes go on", "[light-paths]")
   for (int y = 0; y + 1 < W; ++y)
     for (int x = 0; x + 1 < W; ++x) {
       double s = 0;
-      for (const auto& f : ref_films) s += pixel(f, x, y) + pixel(f, x + 1, y) + pixel(f, x, y + 1) + pixel(f, x + 1, y + 1);
+      for (const auto& f : ref_films)
+        s += pixel(f, x, y) + pixel(f, x + 1, y) + pixel(f, x, y + 1) + pixel(f, x + 1, y + 1);
       if (s > best) best = s, bx = x, by = y;
     }
   auto core = [&](const TransientFilm& f) {
-    return pixel(f, bx, by) + pixel(f, bx + 1, by) + pixel(f, bx, by + 1) + pixel(f, bx + 1, by + 1);
+    return pixel(f, bx, by) + pixel(f, bx + 1, by) + pixel(f, bx, by + 1) +
+           pixel(f, bx + 1, by + 1);
   };
   std::vector<double> ref;
   for (const auto& f : ref_films) ref.push_back(core(f));
@@ -407,20 +428,25 @@ TEST_CASE("the photon estimate's bias shrinks as passes go on", "[light-paths]")
   PhotonDesc progressive = fixed;
   progressive.alpha = 0.3;  // fast shrinking, to resolve the change within a short test
   std::vector<double> a, b;
-  for (const auto& f : batches(scene, IntegratorKind::Photons, 48, 8, 1200, fixed)) a.push_back(core(f));
-  for (const auto& f : batches(scene, IntegratorKind::Photons, 48, 8, 1300, progressive)) b.push_back(core(f));
+  for (const auto& f : batches(scene, IntegratorKind::Photons, 48, 8, 1200, fixed))
+    a.push_back(core(f));
+  for (const auto& f : batches(scene, IntegratorKind::Photons, 48, 8, 1300, progressive))
+    b.push_back(core(f));
   const MeanSE fa = mean_se(a), fb = mean_se(b);
   const double bias_fixed = fa.mean - r.mean, bias_prog = fb.mean - r.mean;
-  INFO("peak block at " << bx << "," << by << ": reference " << r.mean << " +- " << r.se << ", fixed radius "
-                        << fa.mean << " +- " << fa.se << ", progressive " << fb.mean << " +- " << fb.se);
-  // The wide fixed kernel blurs light out of the peak (significantly); shrinking removes much of it.
+  INFO("peak block at " << bx << "," << by << ": reference " << r.mean << " +- " << r.se
+                        << ", fixed radius " << fa.mean << " +- " << fa.se << ", progressive "
+                        << fb.mean << " +- " << fb.se);
+  // The wide fixed kernel blurs light out of the peak (significantly); shrinking removes much of
+  // it.
   REQUIRE(bias_fixed < -4.0 * std::hypot(fa.se, r.se));
   CHECK(std::abs(bias_prog) < 0.6 * std::abs(bias_fixed));
   CHECK(bias_prog - bias_fixed > 4.0 * std::hypot(fa.se, fb.se));
 }
 
 // Catches: splat order or photon order depending on how work is split between threads.
-TEST_CASE("light tracing and photon mapping are bit-identical for 1 and 2 threads", "[light-paths]") {
+TEST_CASE("light tracing and photon mapping are bit-identical for 1 and 2 threads",
+          "[light-paths]") {
   SceneDesc d;
   d.source = "determinism";
   d.camera = perspective({0, 30, 100}, {0, 10, 0}, 50, 12, 10);
@@ -443,7 +469,8 @@ TEST_CASE("light tracing and photon mapping are bit-identical for 1 and 2 thread
       opt.quiet = true;
       const RenderResult res = render(scene, opt);
       const float* v = res.film.transient();
-      out.emplace_back(v, v + static_cast<size_t>(res.film.width() * res.film.height() * res.film.bins() * 3));
+      out.emplace_back(
+          v, v + static_cast<size_t>(res.film.width() * res.film.height() * res.film.bins() * 3));
     }
     CHECK(out[0] == out[1]);
   }

@@ -8,10 +8,14 @@ namespace femto {
 
 const char* integrator_name(IntegratorKind kind) {
   switch (kind) {
-    case IntegratorKind::Auto: return "auto";
-    case IntegratorKind::Path: return "path";
-    case IntegratorKind::Light: return "light";
-    case IntegratorKind::Photons: return "photons";
+    case IntegratorKind::Auto:
+      return "auto";
+    case IntegratorKind::Path:
+      return "path";
+    case IntegratorKind::Light:
+      return "light";
+    case IntegratorKind::Photons:
+      return "photons";
   }
   return "?";
 }
@@ -22,11 +26,15 @@ IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, s
     return kind;
   }
   const bool delta_light = !scene.lights.empty();  // point, spot and laser lights are all deltas
-  const bool non_diffuse = std::any_of(scene.shapes.begin(), scene.shapes.end(), [](const ShapeDesc& s) {
-    return s.material.type != MaterialDesc::Type::None && s.material.type != MaterialDesc::Type::Diffuse;
-  });
+  const bool non_diffuse =
+      std::any_of(scene.shapes.begin(), scene.shapes.end(), [](const ShapeDesc& s) {
+        return s.material.type != MaterialDesc::Type::None &&
+               s.material.type != MaterialDesc::Type::Diffuse;
+      });
   if (!delta_light || !non_diffuse) {
-    why = "auto: no caustics to gather (needs a point, spot or laser light and a non-diffuse surface)";
+    why =
+        "auto: no caustics to gather (needs a point, spot or laser light and a non-diffuse "
+        "surface)";
     return IntegratorKind::Path;
   }
   if (scene.reconstruction.type == TemporalFilter::Kind::Kernel) {
@@ -42,6 +50,8 @@ double default_photon_radius(const Scene& scene) {
   return 0.005 * (diag > 0 ? diag : 1.0);
 }
 
-double default_photon_bandwidth(const SceneDesc& scene) { return scene.time.bin_width_ps; }
+double default_photon_bandwidth(const SceneDesc& scene) {
+  return scene.time.bin_width_ps;
+}
 
 }  // namespace femto

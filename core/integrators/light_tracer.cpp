@@ -13,8 +13,9 @@ LightTracer::LightTracer(const Scene& scene, int max_depth, double t_cut_ps)
       t_cut_(t_cut_ps),
       unwarp_(scene.desc().time_mode == TimeMode::Unwarp) {}
 
-void LightTracer::splat(const Vec3& x, int m, const Vec3& w, double dist, const RGB& value, double t_ps,
-                        double sigma_ps, double fx, double fy, std::vector<Splat>& out, PathStats& stats) const {
+void LightTracer::splat(const Vec3& x, int m, const Vec3& w, double dist, const RGB& value,
+                        double t_ps, double sigma_ps, double fx, double fy, std::vector<Splat>& out,
+                        PathStats& stats) const {
   if (value.is_black()) return;
   double Tr, dt;
   if (!tracker_.connect(x, m, w, dist, Tr, dt, stats)) return;
@@ -40,12 +41,14 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
     switch (v.kind) {
       case LightVertex::Kind::Emitter: {
         const double cos_e = dot(v.n, w);
-        if (cos_e > 0) splat(v.p + v.n * eps, v.medium, w, dist, v.beta * (cos_e * W), v.t_ps, v.sigma_ps, fx, fy, out, stats);
+        if (cos_e > 0)
+          splat(v.p + v.n * eps, v.medium, w, dist, v.beta * (cos_e * W), v.t_ps, v.sigma_ps, fx,
+                fy, out, stats);
         return true;
       }
       case LightVertex::Kind::Medium:
-        splat(v.p, v.medium, w, dist, v.beta * (hg_eval(dot(v.d, w), v.g) * W), v.t_ps, v.sigma_ps, fx, fy, out,
-              stats);
+        splat(v.p, v.medium, w, dist, v.beta * (hg_eval(dot(v.d, w), v.g) * W), v.t_ps, v.sigma_ps,
+              fx, fy, out, stats);
         return !v.connection_only;
       case LightVertex::Kind::Surface: {
         if (v.bsdf->is_delta()) return true;
@@ -55,8 +58,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
         if (f.is_black()) return true;
         const Vec3& ng = v.hit->ng;
         const int m = out_side ? scene_.outside_medium() : scene_.inside_medium(v.hit->shape);
-        splat(v.p + ng * (out_side ? eps : -eps), m, w, dist - eps, v.beta * f * (std::abs(wi.z) * W), v.t_ps,
-              v.sigma_ps, fx, fy, out, stats);
+        splat(v.p + ng * (out_side ? eps : -eps), m, w, dist - eps,
+              v.beta * f * (std::abs(wi.z) * W), v.t_ps, v.sigma_ps, fx, fy, out, stats);
         return true;
       }
     }

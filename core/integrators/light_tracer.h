@@ -14,7 +14,7 @@ namespace femto {
 
 /// One contribution of a light path to one pixel.
 struct Splat {
-  uint32_t pixel = 0;   ///< y * width + x
+  uint32_t pixel = 0;  ///< y * width + x
   double t_ps = 0;
   double sigma_ps = 0;  ///< pulse std
   RGB value;            ///< mean radiance added to the pixel times the number of light paths
@@ -27,9 +27,11 @@ class LightTracer {
   void trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) const;
 
  private:
-  /// Splat of the connection x -> sensor from medium m leaving along a known side (x already offset).
-  void splat(const Vec3& x, int m, const Vec3& w, double dist, const RGB& value, double t_ps, double sigma_ps,
-             double fx, double fy, std::vector<Splat>& out, PathStats& stats) const;
+  /// Splat of the connection x -> sensor from medium m leaving along a known side (x already
+  /// offset).
+  void splat(const Vec3& x, int m, const Vec3& w, double dist, const RGB& value, double t_ps,
+             double sigma_ps, double fx, double fy, std::vector<Splat>& out,
+             PathStats& stats) const;
 
   const Scene& scene_;
   MediumTracker tracker_;

@@ -21,7 +21,8 @@ constexpr double kSameSurfaceCos = 0.7;
 }  // namespace
 
 size_t PhotonGrid::cell_hash(int64_t ix, int64_t iy, int64_t iz) const {
-  const uint64_t h = (static_cast<uint64_t>(ix) * 73856093ULL) ^ (static_cast<uint64_t>(iy) * 19349663ULL) ^
+  const uint64_t h = (static_cast<uint64_t>(ix) * 73856093ULL) ^
+                     (static_cast<uint64_t>(iy) * 19349663ULL) ^
                      (static_cast<uint64_t>(iz) * 83492791ULL);
   return static_cast<size_t>(mix64(h) & (start_.size() - 2));
 }
@@ -34,13 +35,16 @@ void PhotonGrid::build(std::vector<Photon> photons, double radius) {
   while (table < 2 * photons.size()) table <<= 1;
   start_.assign(table + 1, 0);  // power-of-two slots + 1 end marker
   std::vector<uint32_t> slot(photons.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, photons.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) {
-      const Vec3 q = (photons[i].p - origin_) * inv_cell_;
-      slot[i] = static_cast<uint32_t>(cell_hash(static_cast<int64_t>(std::floor(q.x)), static_cast<int64_t>(std::floor(q.y)),
-                                                static_cast<int64_t>(std::floor(q.z))));
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, photons.size(), 4096),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        const Vec3 q = (photons[i].p - origin_) * inv_cell_;
+                        slot[i] =
+                            static_cast<uint32_t>(cell_hash(static_cast<int64_t>(std::floor(q.x)),
+                                                            static_cast<int64_t>(std::floor(q.y)),
+                                                            static_cast<int64_t>(std::floor(q.z))));
+                      }
+                    });
   // Stable counting sort by slot: photon order within a slot stays the trace order.
   for (uint32_t s : slot) ++start_[s + 1];
   for (size_t h = 1; h < start_.size(); ++h) start_[h] += start_[h - 1];
@@ -53,8 +57,9 @@ uint64_t PhotonGrid::memory_bytes() const {
   return photons_.capacity() * sizeof(Photon) + start_.capacity() * sizeof(uint32_t);
 }
 
-void PhotonGather::gather(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame, const Vec3& wo,
-                          const RGB& beta, double t_ps, PixelAccumulator& acc, PathStats& stats) const {
+void PhotonGather::gather(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame,
+                          const Vec3& wo, const RGB& beta, double t_ps, PixelAccumulator& acc,
+                          PathStats& stats) const {
   ++stats.photon_gathers;
   const double norm = inv_emitted / (kPi * radius * radius);  // disc kernel 1 / (pi R^2)
   grid->query(hit.p, radius, [&](const Photon& ph) {
@@ -71,31 +76,36 @@ void PhotonGather::gather(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& 
   });
 }
 
-std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count, int max_depth,
-                                  double t_cut_ps, PathStats& stats) {
+std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count,
+                                  int max_depth, double t_cut_ps, PathStats& stats) {
   const MediumTracker tracker(scene);
   const int64_t chunks = (count + kChunk - 1) / kChunk;
   std::vector<std::vector<Photon>> per_chunk(static_cast<size_t>(chunks));
   tbb::enumerable_thread_specific<PathStats> local;
-  tbb::parallel_for(tbb::blocked_range<int64_t>(0, chunks, 1), [&](const tbb::blocked_range<int64_t>& r) {
-    PathStats& st = local.local();
-    for (int64_t c = r.begin(); c != r.end(); ++c) {
-      std::vector<Photon>& out = per_chunk[static_cast<size_t>(c)];
-      const int64_t end = std::min(count, (c + 1) * kChunk);
-      for (int64_t i = c * kChunk; i < end; ++i) {
-        Rng rng = Rng::for_sample(seed, kPhotonStream + static_cast<uint64_t>(pass), static_cast<uint64_t>(i));
-        walk_light_path(scene, tracker, rng, max_depth, t_cut_ps, st, [&](const LightVertex& v) {
-          if (v.kind != LightVertex::Kind::Surface) return v.kind == LightVertex::Kind::Emitter;
-          if (!v.bsdf->is_diffuse()) return true;  // glossy and specular chains go on
-          if (v.chain >= 1) {                      // light -> non-diffuse surfaces -> here
-            out.push_back({v.p, v.hit->ng, -v.d, v.beta, v.t_ps, v.sigma_ps});
-            ++st.photons_stored;
+  tbb::parallel_for(
+      tbb::blocked_range<int64_t>(0, chunks, 1), [&](const tbb::blocked_range<int64_t>& r) {
+        PathStats& st = local.local();
+        for (int64_t c = r.begin(); c != r.end(); ++c) {
+          std::vector<Photon>& out = per_chunk[static_cast<size_t>(c)];
+          const int64_t end = std::min(count, (c + 1) * kChunk);
+          for (int64_t i = c * kChunk; i < end; ++i) {
+            Rng rng = Rng::for_sample(seed, kPhotonStream + static_cast<uint64_t>(pass),
+                                      static_cast<uint64_t>(i));
+            walk_light_path(scene, tracker, rng, max_depth, t_cut_ps, st,
+                            [&](const LightVertex& v) {
+                              if (v.kind != LightVertex::Kind::Surface)
+                                return v.kind == LightVertex::Kind::Emitter;
+                              if (!v.bsdf->is_diffuse())
+                                return true;       // glossy and specular chains go on
+                              if (v.chain >= 1) {  // light -> non-diffuse surfaces -> here
+                                out.push_back({v.p, v.hit->ng, -v.d, v.beta, v.t_ps, v.sigma_ps});
+                                ++st.photons_stored;
+                              }
+                              return false;  // after a diffuse vertex the camera paths take over
+                            });
           }
-          return false;  // after a diffuse vertex the camera paths take over
-        });
-      }
-    }
-  });
+        }
+      });
   for (const PathStats& s : local) stats += s;
   size_t total = 0;
   for (const auto& v : per_chunk) total += v.size();

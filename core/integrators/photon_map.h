@@ -16,11 +16,11 @@
 namespace femto {
 
 struct Photon {
-  Vec3 p;             ///< position on a diffuse surface
-  Vec3 n;             ///< geometric normal of that surface (outward / front)
-  Vec3 wi;            ///< unit direction back towards where the photon came from
-  RGB power;          ///< flux weight (divide by the photons emitted in the pass)
-  double t_ps = 0;    ///< emission time + flight time to p
+  Vec3 p;               ///< position on a diffuse surface
+  Vec3 n;               ///< geometric normal of that surface (outward / front)
+  Vec3 wi;              ///< unit direction back towards where the photon came from
+  RGB power;            ///< flux weight (divide by the photons emitted in the pass)
+  double t_ps = 0;      ///< emission time + flight time to p
   double sigma_ps = 0;  ///< pulse std of its light
 };
 
@@ -38,8 +38,8 @@ class PhotonGrid {
 
  private:
   size_t cell_hash(int64_t ix, int64_t iy, int64_t iz) const;
-  std::vector<Photon> photons_;     ///< sorted by cell
-  std::vector<uint32_t> start_;     ///< table: photons of hash h are [start_[h], start_[h + 1])
+  std::vector<Photon> photons_;  ///< sorted by cell
+  std::vector<uint32_t> start_;  ///< table: photons of hash h are [start_[h], start_[h + 1])
   double cell_ = 1, inv_cell_ = 1;
   Vec3 origin_;
 };
@@ -53,8 +53,8 @@ struct PhotonGather {
   TemporalFilter kernel;    ///< kernel filter on the film's axis
   /// Adds the radiance estimate at a diffuse surface vertex (local frame z = hit.ng) seen with
   /// throughput beta at camera time t_ps.
-  void gather(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame, const Vec3& wo, const RGB& beta,
-              double t_ps, PixelAccumulator& acc, PathStats& stats) const;
+  void gather(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame, const Vec3& wo,
+              const RGB& beta, double t_ps, PixelAccumulator& acc, PathStats& stats) const;
 };
 
 /// Upper bound on the memory of one pass with `per_pass` photons: every photon kept, the traced
@@ -68,15 +68,17 @@ inline uint64_t photon_pass_bytes(int64_t per_pass) {
 
 /// Traces `count` photons of one pass (streams keyed by seed, pass and photon index) and returns
 /// the caustic ones in photon order: the same list for any thread count.
-std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count, int max_depth,
-                                  double t_cut_ps, PathStats& stats);
+std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count,
+                                  int max_depth, double t_cut_ps, PathStats& stats);
 
 template <class F>
 void PhotonGrid::query(const Vec3& x, double radius, F&& f) const {
   if (photons_.empty()) return;
   const double r2 = radius * radius;
   // Cells overlapping [x - r, x + r]: with cells of 2r, at most two per axis.
-  const auto lo = [&](double v, double o) { return static_cast<int64_t>(std::floor((v - radius - o) * inv_cell_)); };
+  const auto lo = [&](double v, double o) {
+    return static_cast<int64_t>(std::floor((v - radius - o) * inv_cell_));
+  };
   const int64_t x0 = lo(x.x, origin_.x), y0 = lo(x.y, origin_.y), z0 = lo(x.z, origin_.z);
   size_t visited[8];
   int n_visited = 0;

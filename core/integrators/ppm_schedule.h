@@ -2,7 +2,8 @@
 // Spatial radius and temporal bandwidth of transient progressive photon mapping, pass by pass
 // (seed 000 eq. 10, Supp. C): the kernel volume R^2 T shrinks by (j + alpha) / (j + 1) per pass,
 // R^2 taking the power beta_R = 1 - beta_T and T the power beta_T:
-//   R_{j+1}^2 = R_j^2 ((j + alpha) / (j + 1))^beta_R,   T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_T.
+//   R_{j+1}^2 = R_j^2 ((j + alpha) / (j + 1))^beta_R,   T_{j+1} = T_j ((j + alpha) / (j +
+//   1))^beta_T.
 // Bias ~ R^2 + T^2 ~ n^{-(1-alpha) beta_R} + n^{-2 (1-alpha) beta_T} balances at beta_T = 1/3;
 // variance ~ 1 / (n R^2 T) ~ n^{-alpha}; the mean squared error then falls fastest, as n^{-4/7},
 // at alpha = 4/7.

@@ -4,9 +4,9 @@
 #include <limits>
 
 #include "core/constants.h"
+#include "core/integrators/photon_map.h"
 #include "core/sampling.h"
 #include "media/phase_hg.h"
-#include "core/integrators/photon_map.h"
 
 namespace femto {
 
@@ -47,8 +47,8 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
 
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
                                                const RGB& beta, double t, const DirectionMix* mix,
-                                               bool skip_point_lights, Rng& rng, PixelAccumulator& acc,
-                                               PathStats& stats) const {
+                                               bool skip_point_lights, Rng& rng,
+                                               PixelAccumulator& acc, PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
@@ -63,20 +63,22 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
   const double p_dir = ls.is_delta ? 0.0 : mix ? direction_pdf(*mix, x, d, g, ls.wi) : f;
   const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, p_dir);
   const Light& L = lights.light(li);
-  deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(), beta * ls.Li * (f * Tr * w / (pmf * ls.pdf)), acc,
-          stats);
+  deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(),
+          beta * ls.Li * (f * Tr * w / (pmf * ls.pdf)), acc, stats);
 }
 
-void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame,
-                                                const Vec3& wo, bool wo_outside, const RGB& beta, double t,
-                                                Rng& rng, PixelAccumulator& acc, PathStats& stats) const {
+void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit,
+                                                const Frame& frame, const Vec3& wo, bool wo_outside,
+                                                const RGB& beta, double t, Rng& rng,
+                                                PixelAccumulator& acc, PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
   const double u1 = rng.uniform(), u2 = rng.uniform();
   if (li < 0) return;
   const double eps = scene_.ray_epsilon();
-  // Probe point for the light sample: the side of wo; a transmitted sample leaves from the other side.
+  // Probe point for the light sample: the side of wo; a transmitted sample leaves from the other
+  // side.
   LightSample ls;
   const Vec3 x_wo = hit.p + hit.ng * (wo_outside ? eps : -eps);
   if (!lights.sample(li, x_wo, u1, u2, ls)) return;
@@ -108,14 +110,14 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
 
   int m = scene_.outside_medium();
   RGB beta(1.0);
-  double t = 0.0;             // time of flight from the sensor to the current vertex, ps
+  double t = 0.0;                 // time of flight from the sensor to the current vertex, ps
   bool on_camera_segment = true;  // unwarp mode drops the time of the sensor's own segment
-  bool specular = true;       // previous vertex was the sensor or a specular surface
-  double prev_pdf = 0.0;      // solid-angle pdf of the direction sampled at the previous vertex
+  bool specular = true;           // previous vertex was the sensor or a specular surface
+  double prev_pdf = 0.0;          // solid-angle pdf of the direction sampled at the previous vertex
   Vec3 prev_p = ray.o;
   int depth = 0;
   int null_crossings = 0;
-  double u_next = -1.0;       // pre-drawn distance uniform for the next segment (angular sampling)
+  double u_next = -1.0;  // pre-drawn distance uniform for the next segment (angular sampling)
   // Path-space partition with photons (docs/ARCHITECTURE.md): light reaching a diffuse vertex
   // through one or more non-diffuse surfaces belongs to the photons. 0: no diffuse vertex yet or
   // a medium event since; 1: just left a diffuse vertex; 2: non-diffuse surfaces since it.
@@ -128,7 +130,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     const Medium& med = media[static_cast<size_t>(m)];
     const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next);
     const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
-    const bool segment_connections = med.connection != ConnectionSampling::Collision && !point_lights_.empty();
+    const bool segment_connections =
+        med.connection != ConnectionSampling::Collision && !point_lights_.empty();
     if (segment_connections && depth < max_depth_)
       estimate_segment(med, m, ray, s_surf, beta, t, t_dropped, rng, acc, stats);
     // Angular direction sampling: the next segment's distance draw is made now so that every
@@ -137,7 +140,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
                          ms.main.collided && depth < max_depth_;
     u_next = angular ? rng.uniform() : -1.0;
     const double t_main = t + ms.main.opl * t_dropped;
-    const DirectionMix mix_main = angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next) : DirectionMix{};
+    const DirectionMix mix_main =
+        angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next) : DirectionMix{};
     if (ms.extra.collided && depth < max_depth_) {
       // The time-uniform collision of MIS: next-event estimation only (the path goes on from
       // the mean-free-path collision).
@@ -167,10 +171,11 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const Vec3 x = ray.at(ev.s);
       beta *= MediumTracker::albedo_at(med, x);
       if (beta.is_black()) break;
-      estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t, angular ? &mix_main : nullptr,
-                             segment_connections, rng, acc, stats);
+      estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t,
+                             angular ? &mix_main : nullptr, segment_connections, rng, acc, stats);
       Vec3 wi;
-      beta *= sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone
+      beta *=
+          sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone
       if (beta.is_black()) break;
       specular = false;
       prev_p = x;

@@ -39,36 +39,38 @@ class VolPathIntegrator {
   /// r_aux (the segment length angular sampling assumes) is shared by every strategy's weights.
   struct DirectionMix {
     bool active = false;
-    double u = 0;      ///< raw uniform of the next segment's main distance draw
-    double r_aux = 0;  ///< segment length implied by u at the vertex, mm
-    double eta = 1;    ///< index at the vertex
-    double t = 0;      ///< path time at the vertex, ps
+    double u = 0;          ///< raw uniform of the next segment's main distance draw
+    double r_aux = 0;      ///< segment length implied by u at the vertex, mm
+    double eta = 1;        ///< index at the vertex
+    double t = 0;          ///< path time at the vertex, ps
     double valid_pmf = 0;  ///< total pick probability of the point lights whose window is reachable
   };
   DirectionMix direction_mix(const Medium& med, const Vec3& x, double t, double u) const;
   /// Density (per steradian) of direction w at x: phase alone, or the phase/angular mixture.
-  double direction_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g, const Vec3& w) const;
+  double direction_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g,
+                       const Vec3& w) const;
   double angular_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& w) const;
   /// Samples the next direction; returns f / pdf (1 for phase sampling alone) and the pdf.
-  double sample_direction(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g, Rng& rng, Vec3& w,
-                          double& pdf) const;
+  double sample_direction(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g, Rng& rng,
+                          Vec3& w, double& pdf) const;
   /// Next-event estimation from a medium point x reached along direction d with throughput beta.
   /// `mix` (may be null) gives the direction density for MIS with area lights; point and spot
   /// lights are left to estimate_segment when the medium uses segment connections.
-  void estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g, const RGB& beta, double t,
-                              const DirectionMix* mix, bool skip_point_lights, Rng& rng, PixelAccumulator& acc,
-                              PathStats& stats) const;
+  void estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g, const RGB& beta,
+                              double t, const DirectionMix* mix, bool skip_point_lights, Rng& rng,
+                              PixelAccumulator& acc, PathStats& stats) const;
   /// Direct light from a point or spot light scattered anywhere on [0, s_surf) of `ray` in
   /// medium m (equiangular, line-to-point, or both by MIS). t_factor converts optical path
   /// length to time (0 on the camera segment in unwarp mode).
-  void estimate_segment(const Medium& med, int m, const Ray& ray, double s_surf, const RGB& beta, double t,
-                        double t_factor, Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
+  void estimate_segment(const Medium& med, int m, const Ray& ray, double s_surf, const RGB& beta,
+                        double t, double t_factor, Rng& rng, PixelAccumulator& acc,
+                        PathStats& stats) const;
   void deposit(double t_ps, double sigma_ps, const RGB& value, PixelAccumulator& acc,
                PathStats& stats) const;
   /// Next-event estimation at a surface vertex with a non-delta BSDF (local frame z = ng).
-  void estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame, const Vec3& wo,
-                               bool wo_outside, const RGB& beta, double t, Rng& rng, PixelAccumulator& acc,
-                               PathStats& stats) const;
+  void estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame,
+                               const Vec3& wo, bool wo_outside, const RGB& beta, double t, Rng& rng,
+                               PixelAccumulator& acc, PathStats& stats) const;
 
   const Scene& scene_;
   MediumTracker tracker_;
@@ -76,8 +78,8 @@ class VolPathIntegrator {
   int max_depth_;
   bool unwarp_;
   double t_cut_;
-  std::vector<int> point_lights_;   ///< point and spot lights: targets of angular sampling
-  std::vector<double> point_pmf_;   ///< their pick probabilities, proportional to power
+  std::vector<int> point_lights_;  ///< point and spot lights: targets of angular sampling
+  std::vector<double> point_pmf_;  ///< their pick probabilities, proportional to power
 };
 
 }  // namespace femto

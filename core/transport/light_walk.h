@@ -20,18 +20,18 @@ namespace femto {
 struct LightVertex {
   enum class Kind { Emitter, Surface, Medium };
   Kind kind = Kind::Medium;
-  Vec3 p;                          ///< position
-  Vec3 d;                          ///< propagation direction of the path arriving at p
-  Vec3 n;                          ///< emitter: unit emitting normal
-  int medium = 0;                  ///< medium the path arrived through
-  const SurfaceHit* hit = nullptr; ///< surface vertices
-  const Bsdf* bsdf = nullptr;      ///< surface vertices
-  const Frame* frame = nullptr;    ///< surface vertices: local frame, z = hit->ng
-  Vec3 wo;                         ///< surface vertices: -d in the local frame
-  double g = 0;                    ///< medium vertices: HG asymmetry
-  RGB beta;                        ///< flux weight arriving at p (emitter: Le / pdf_pos)
-  double t_ps = 0;                 ///< emission time (pulse centre) + flight time to p
-  double sigma_ps = 0;             ///< the light's pulse std
+  Vec3 p;                           ///< position
+  Vec3 d;                           ///< propagation direction of the path arriving at p
+  Vec3 n;                           ///< emitter: unit emitting normal
+  int medium = 0;                   ///< medium the path arrived through
+  const SurfaceHit* hit = nullptr;  ///< surface vertices
+  const Bsdf* bsdf = nullptr;       ///< surface vertices
+  const Frame* frame = nullptr;     ///< surface vertices: local frame, z = hit->ng
+  Vec3 wo;                          ///< surface vertices: -d in the local frame
+  double g = 0;                     ///< medium vertices: HG asymmetry
+  RGB beta;                         ///< flux weight arriving at p (emitter: Le / pdf_pos)
+  double t_ps = 0;                  ///< emission time (pulse centre) + flight time to p
+  double sigma_ps = 0;              ///< the light's pulse std
   /// Non-diffuse surfaces met since emission, or -1 once the path has scattered in a medium or
   /// off a diffuse surface (the caustic-path test of the photon partition).
   int chain = 0;
@@ -43,7 +43,8 @@ struct LightVertex {
 /// Medium a ray starts in: the interior of the first surface it leaves, else the outside.
 inline int medium_at_origin(const Scene& scene, const Ray& ray) {
   SurfaceHit hit;
-  if (!scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit)) return scene.outside_medium();
+  if (!scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit))
+    return scene.outside_medium();
   return dot(ray.d, hit.ng) > 0 ? scene.inside_medium(hit.shape) : scene.outside_medium();
 }
 
@@ -51,8 +52,8 @@ inline int medium_at_origin(const Scene& scene, const Ray& ray) {
 /// whether the path goes on. Paths stop at t_cut_ps, at max_depth scattering vertices (counted),
 /// or when the visitor stops them.
 template <class Visitor>
-void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng, int max_depth, double t_cut_ps,
-                     PathStats& stats, Visitor&& visit) {
+void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng, int max_depth,
+                     double t_cut_ps, PathStats& stats, Visitor&& visit) {
   const LightSet& lights = scene.lights();
   const auto& media = scene.media();
   const auto& shapes = scene.desc().shapes;
@@ -85,7 +86,8 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
 
   for (;;) {
     SurfaceHit hit;
-    const bool found = scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit);
+    const bool found =
+        scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit);
     const double s_surf = found ? hit.s : std::numeric_limits<double>::infinity();
     const Medium& med = media[static_cast<size_t>(m)];
     const MediumSample ms = tracker.sample(med, ray, s_surf, rng);
@@ -151,8 +153,8 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
       return;
     }
     ++depth;
-    const Bsdf bsdf =
-        Bsdf::from_material(sh.material, media[static_cast<size_t>(scene.outside_medium())].eta_at(hit.p));
+    const Bsdf bsdf = Bsdf::from_material(
+        sh.material, media[static_cast<size_t>(scene.outside_medium())].eta_at(hit.p));
     const Frame frame(hit.ng);
     v = LightVertex{};
     v.kind = LightVertex::Kind::Surface;

@@ -37,7 +37,8 @@ class MediumTracker {
 
   /// Next collision in `med` along `ray` before s_max (a surface, or infinity).
   /// `u_main` >= 0 replaces the main distance draw (angular direction sampling draws it early).
-  MediumSample sample(const Medium& med, const Ray& ray, double s_max, Rng& rng, double u_main = -1) const;
+  MediumSample sample(const Medium& med, const Ray& ray, double s_max, Rng& rng,
+                      double u_main = -1) const;
   /// Transmittance and time of flight of a straight connection x -> x + dist * w starting in
   /// medium m, passing through index-matched boundaries; false if a surface with a material
   /// blocks it.
