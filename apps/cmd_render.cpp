@@ -151,23 +151,29 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why, cons
       j["description"] = "light paths, every non-delta vertex connected to the camera";
       j["light_paths"] = result.light_paths;
       break;
-    case IntegratorKind::Photons: {
+    case IntegratorKind::Photons:
+    case IntegratorKind::Beams: {
+      const bool beams = kind == IntegratorKind::Beams;
       const auto& p = result.photons;
       j["description"] =
-          "camera paths + transient progressive photon mapping: photons that reach a diffuse surface through "
-          "non-diffuse surfaces are gathered there; camera paths leave those paths out";
+          beams ? "camera paths + transient progressive photon beams: every light-path segment in a scattering "
+                  "medium is a beam; light scattered in media before a camera path's first non-specular surface "
+                  "comes from the beams gathered along its segments"
+                : "camera paths + transient progressive photon mapping: photons that reach a diffuse surface "
+                  "through non-diffuse surfaces are gathered there; camera paths leave those paths out";
       j["passes"] = p.passes;
       j["camera_samples_per_pass"] = 1;
       j["photons_per_pass"] = p.per_pass;
       j["radius_mm"] = {{"first_pass", p.radius_first}, {"last_pass", p.radius_last}};
       j["bandwidth_ps"] = {{"first_pass", p.bandwidth_first_ps}, {"last_pass", p.bandwidth_last_ps}};
-      j["alpha"] = opt.photons.alpha;
-      j["beta_t"] = opt.photons.beta_t;
+      j["alpha"] = p.alpha;
+      j["beta_t"] = p.beta_t;
       j["temporal_kernel"] = opt.photons.kernel == TemporalKernel::Perlin ? "perlin" : "epanechnikov";
-      j["spatial_kernel"] = "disc, 1 / (pi R^2)";
-      j["schedule"] = "R_{j+1}^2 = R_j^2 ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_t";
-      j["max_photons_stored_per_pass"] = p.max_stored_per_pass;
-      j["photon_memory_bytes_peak"] = p.peak_photon_bytes;
+      j["spatial_kernel"] = beams ? "1-D across the beam, 1 / (2 R), with 1 / sin(theta)" : "disc, 1 / (pi R^2)";
+      j["schedule"] = beams ? "R_{j+1} = R_j ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_t"
+                            : "R_{j+1}^2 = R_j^2 ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_t";
+      j[beams ? "max_beams_stored_per_pass" : "max_photons_stored_per_pass"] = p.max_stored_per_pass;
+      j[beams ? "beam_memory_bytes_peak" : "photon_memory_bytes_peak"] = p.peak_photon_bytes;
       break;
     }
     case IntegratorKind::Auto:
@@ -205,7 +211,7 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
             {"integrator", integrator_name(kind)},
             {"light_paths", kind == IntegratorKind::Light ? opt.light_paths : 0},
             {"photons",
-             kind != IntegratorKind::Photons
+             kind != IntegratorKind::Photons && kind != IntegratorKind::Beams
                  ? nlohmann::json(nullptr)
                  : nlohmann::json{{"per_pass", pd.per_pass},
                                   {"radius", pd.radius},
@@ -315,7 +321,8 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       else if (v == "path") integrator = IntegratorKind::Path;
       else if (v == "light") integrator = IntegratorKind::Light;
       else if (v == "photons") integrator = IntegratorKind::Photons;
-      else args.fail("expected auto, path, light or photons", v);
+      else if (v == "beams") integrator = IntegratorKind::Beams;
+      else args.fail("expected auto, path, light, photons or beams", v);
     } else if (a == "--light-paths") {
       light_paths = static_cast<int64_t>(args.int_value(1, 1000000000000LL));
     } else if (a == "--photons") {
@@ -403,9 +410,10 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     throw InputError(where + ": integrator \"" + integrator_name(kind) +
                      "\": the kernel film (/time/reconstruction kernel) works with camera paths only; use "
                      "--integrator path or the histogram film");
-  if (!photon_flag.empty() && kind != IntegratorKind::Photons)
-    throw InputError("femto render: " + photon_flag + ": applies to photon mapping only, but the integrator is \"" +
-                     integrator_name(kind) + "\"; add --integrator photons");
+  if (!photon_flag.empty() && kind != IntegratorKind::Photons && kind != IntegratorKind::Beams)
+    throw InputError("femto render: " + photon_flag +
+                     ": applies to photon mapping and photon beams only, but the integrator is \"" +
+                     integrator_name(kind) + "\"; add --integrator photons or beams");
   if (light_paths && kind != IntegratorKind::Light)
     throw InputError("femto render: --light-paths: applies to --integrator light only");
   RenderOptions opt;
@@ -588,7 +596,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"nonfinite_film_values_zeroed", film_nonfinite},
                       {"light_paths", st.light_paths},
                       {"photons_stored", st.photons_stored},
-                      {"photon_gathers", st.photon_gathers}};
+                      {"photon_gathers", st.photon_gathers},
+                      {"beams_stored", st.beams_stored},
+                      {"beam_gathers", st.beam_gathers}};
   info["timing"] = {{"render_seconds", result.wall_seconds},
                     {"paths_per_second", result.wall_seconds > 0 ? static_cast<double>(st.paths) / result.wall_seconds : 0.0}};
   const int stop_signal = stop_signals::signal_number();

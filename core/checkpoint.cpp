@@ -33,7 +33,9 @@ nlohmann::json stats_json(const PathStats& s) {
           {"nonfinite_dropped", s.nonfinite_dropped},
           {"light_paths", s.light_paths},
           {"photons_stored", s.photons_stored},
-          {"photon_gathers", s.photon_gathers}};
+          {"photon_gathers", s.photon_gathers},
+          {"beams_stored", s.beams_stored},
+          {"beam_gathers", s.beam_gathers}};
 }
 
 PathStats stats_of(const nlohmann::json& j) {
@@ -47,6 +49,8 @@ PathStats stats_of(const nlohmann::json& j) {
   s.light_paths = j.at("light_paths").get<uint64_t>();
   s.photons_stored = j.at("photons_stored").get<uint64_t>();
   s.photon_gathers = j.at("photon_gathers").get<uint64_t>();
+  s.beams_stored = j.at("beams_stored").get<uint64_t>();
+  s.beam_gathers = j.at("beam_gathers").get<uint64_t>();
   return s;
 }
 

@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "core/integrators/light_tracer.h"
+#include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
 #include "core/pixel_sampler.h"
 #include "core/progress.h"
@@ -97,7 +98,8 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
 
 RenderResult render(const Scene& scene, const RenderOptions& opt) {
   if (opt.integrator == IntegratorKind::Light) return render_light(scene, opt);
-  if (opt.integrator == IntegratorKind::Photons) return render_photons(scene, opt);
+  if (opt.integrator == IntegratorKind::Photons || opt.integrator == IntegratorKind::Beams)
+    return render_photons(scene, opt);
   const auto start = std::chrono::steady_clock::now();
   const Camera& camera = scene.camera();
   const int W = camera.width(), H = camera.height();
@@ -215,7 +217,10 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
                                : 0;
   m.per_thread = static_cast<uint64_t>(std::max(1, threads)) * (B * 3 * sizeof(double) + held);
   if (opt.integrator == IntegratorKind::Photons)
-    m.integrator = photon_pass_bytes(opt.photons.per_pass);
+    m.integrator = photon_pass_bytes(opt.photons.per_pass > 0 ? opt.photons.per_pass : 200000);
+  // Beams: an estimate (the beams a light path leaves depend on the scene), about 8 per path.
+  if (opt.integrator == IntegratorKind::Beams)
+    m.integrator = beam_pass_bytes(8 * static_cast<uint64_t>(opt.photons.per_pass > 0 ? opt.photons.per_pass : 20000));
   if (opt.integrator == IntegratorKind::Light) m.integrator = light_batch_bytes(pixels);
   // Writing: a frame, the peak-time image, the contact sheet's 16 frames and its 8-bit image,
   // the 8-bit preview; a multipart EXR is written from the film itself.

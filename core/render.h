@@ -73,6 +73,7 @@ struct RenderResult {
   struct PhotonReport {
     int passes = 0;
     int64_t per_pass = 0;
+    double alpha = 0, beta_t = 0;
     double radius_first = 0, radius_last = 0, bandwidth_first_ps = 0, bandwidth_last_ps = 0;
     uint64_t max_stored_per_pass = 0;
     uint64_t peak_photon_bytes = 0;  ///< largest photon list + grid of one pass
@@ -110,10 +111,11 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
 IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, std::string& why);
 const char* integrator_name(IntegratorKind kind);
 
-/// Default initial photon gather radius: 0.5% of the scene's bounding-box diagonal, mm.
-double default_photon_radius(const Scene& scene);
-/// Default initial temporal bandwidth: one time bin, ps.
-double default_photon_bandwidth(const SceneDesc& scene);
+/// `p` with its automatic values filled in for `kind` (Photons or Beams). Photons: 200000 per
+/// pass, R_1 = 0.5% of the scene's bounding-box diagonal, alpha = 4/7, beta_t = 1/3. Beams:
+/// 20000 light paths per pass, R_1 = 1% of the diagonal, alpha = 2/3, beta_t = 1/2. Both:
+/// T_1 = one time bin.
+PhotonDesc progressive_settings(const Scene& scene, IntegratorKind kind, PhotonDesc p);
 
 /// Traces the spp samples of pixel (x, y) into `acc` (reset first) with the scene's temporal
 /// reconstruction: the whole per-pixel estimator, in double precision, before the film's float.

@@ -1,4 +1,5 @@
-// femto render --integrator photons: camera paths plus transient progressive photon mapping.
+// femto render --integrator photons | beams: camera paths plus transient progressive photon
+// mapping (photons on surfaces) or transient progressive photon beams (media).
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/info.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
 #include "core/integrators/ppm_schedule.h"
 #include "core/pixel_sampler.h"
@@ -27,40 +29,60 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const TimeAxis axis = scene.desc().time;
   const TemporalFilter filter(axis, TemporalFilter::Kind::Histogram);
   const VolPathIntegrator integrator(scene, filter, opt.max_depth);
-  const PhotonDesc& pd = opt.photons;
-  const double R1 = pd.radius > 0 ? pd.radius : default_photon_radius(scene);
-  const double T1 = pd.bandwidth_ps > 0 ? pd.bandwidth_ps : default_photon_bandwidth(scene.desc());
-  PpmSchedule schedule(R1, T1, pd.alpha, pd.beta_t);
+  const IntegratorKind kind =
+      opt.integrator == IntegratorKind::Beams ? IntegratorKind::Beams : IntegratorKind::Photons;
+  const bool use_beams = kind == IntegratorKind::Beams;
+  const PhotonDesc pd = progressive_settings(scene, kind, opt.photons);
+  const double R1 = pd.radius, T1 = pd.bandwidth_ps;
+  PpmSchedule schedule(R1, T1, pd.alpha, pd.beta_t, use_beams ? 1 : 2);
+  const MediumTracker tracker(scene);
   // Photon times include the emission offset: the window end plus the widest pulse spread.
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
 
   const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
   // A pass is one photon pass (and one camera sample per pixel); the schedule's state is the
   // pass index, so a resumed render replays it.
-  RenderState state =
-      passes::start_state(opt, IntegratorKind::Photons, false, pixels, axis.bins, opt.spp);
+  RenderState state = passes::start_state(opt, kind, false, pixels, axis.bins, opt.spp);
   for (int64_t i = 0; i < state.units_done; ++i) schedule.advance();
   const size_t stride = static_cast<size_t>(state.stride);
   const size_t nb = static_cast<size_t>(axis.bins) * 3;
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
 
-  Progress progress(static_cast<uint64_t>(opt.spp), "photon passes", opt.quiet, "passes");
+  Progress progress(static_cast<uint64_t>(opt.spp), use_beams ? "beam passes" : "photon passes",
+                    opt.quiet, "passes");
   progress.add(static_cast<uint64_t>(state.units_done));
   tbb::enumerable_thread_specific<PixelAccumulator> accumulators;
   tbb::enumerable_thread_specific<PathStats> stats;
   PhotonGrid grid;
+  BeamBvh bvh;
   tbb::task_arena arena(threads);
   arena.execute([&] {
     while (state.units_done < opt.spp) {
       const auto pass_start = std::chrono::steady_clock::now();
       const int pass = static_cast<int>(state.units_done);
       PathStats photon_stats;
-      std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth,
-                                                  photon_t_cut, photon_stats);
-      state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());
-      grid.build(std::move(photons), schedule.radius());
-      state.photon_peak_bytes = std::max(state.photon_peak_bytes, grid.memory_bytes());
+      BeamGather beam_gather;
+      if (use_beams) {
+        std::vector<Beam> beams = trace_beams(scene, opt.seed, pass, pd.per_pass, opt.max_depth,
+                                              photon_t_cut, photon_stats);
+        state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, beams.size());
+        bvh.build(std::move(beams), schedule.radius());
+        state.photon_peak_bytes = std::max(state.photon_peak_bytes, bvh.memory_bytes());
+        beam_gather.bvh = &bvh;
+        beam_gather.scene = &scene;
+        beam_gather.tracker = &tracker;
+        beam_gather.radius = schedule.radius();
+        beam_gather.bandwidth_ps = schedule.bandwidth();
+        beam_gather.inv_paths = 1.0 / static_cast<double>(pd.per_pass);
+        beam_gather.kernel = TemporalFilter(axis, TemporalFilter::Kind::Kernel, pd.kernel);
+      } else {
+        std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass,
+                                                    opt.max_depth, photon_t_cut, photon_stats);
+        state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());
+        grid.build(std::move(photons), schedule.radius());
+        state.photon_peak_bytes = std::max(state.photon_peak_bytes, grid.memory_bytes());
+      }
       PhotonGather gather;
       gather.grid = &grid;
       gather.radius = schedule.radius();
@@ -86,7 +108,11 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                   double dx, dy;
                   pixel_offset(opt.seed, p, static_cast<uint64_t>(pass), dx, dy);
                   const double fx = x + dx, fy = y + dy;
-                  integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, &gather);
+                  if (use_beams)
+                    integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, nullptr,
+                                     &beam_gather);
+                  else
+                    integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, &gather);
                   double* dst = state.sums.data() + p * stride;
                   for (size_t i = 0; i < nb; ++i) dst[i] += acc.bins[i];
                   passes::store_rgb(dst + nb, passes::load_rgb(dst + nb) + acc.before);
@@ -103,10 +129,13 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   });
   progress.finish();
   grid = PhotonGrid();
+  bvh = BeamBvh();
   RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};
   RenderResult::PhotonReport& rep = result.photons;
   rep.passes = static_cast<int>(state.units_done);
   rep.per_pass = pd.per_pass;
+  rep.alpha = pd.alpha;
+  rep.beta_t = pd.beta_t;
   rep.radius_first = R1;
   rep.bandwidth_first_ps = T1;
   rep.radius_last = state.photon_radius_last;

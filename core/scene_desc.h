@@ -140,16 +140,19 @@ enum class IntegratorKind {
   Auto,     ///< path + photons when the scene has delta lights and non-diffuse surfaces, else path
   Path,     ///< camera paths only (volumetric path tracing)
   Light,    ///< light paths connected to the camera (light tracing)
-  Photons   ///< camera paths + transient progressive photon mapping for caustics on diffuse surfaces
+  Photons,  ///< camera paths + transient progressive photon mapping for caustics on diffuse surfaces
+  Beams     ///< camera paths + transient progressive photon beams for all light scattered in media
 };
 
-/// Transient progressive photon mapping on surfaces (one pass = photons + one camera sample per pixel).
+/// Progressive density estimation: photons on surfaces or photon beams in media (one pass =
+/// light paths + one camera sample per pixel). Zero (or -1 for beta_t) means the integrator's
+/// default (resolved by progressive_settings in core/render.h).
 struct PhotonDesc {
-  int64_t per_pass = 200000;     ///< photons emitted per pass
-  double radius = 0.0;           ///< initial gather radius R_1, mm; 0 = automatic (scene size)
-  double bandwidth_ps = 0.0;     ///< initial temporal bandwidth T_1, ps; 0 = automatic (4 bins)
-  double alpha = 4.0 / 7.0;      ///< kernel volume ratio per pass, (j + alpha) / (j + 1)
-  double beta_t = 1.0 / 3.0;     ///< share of the shrinkage given to time (beta_R = 1 - beta_t)
+  int64_t per_pass = 0;          ///< light paths (photons) emitted per pass
+  double radius = 0.0;           ///< initial gather radius R_1, mm
+  double bandwidth_ps = 0.0;     ///< initial temporal bandwidth T_1, ps
+  double alpha = 0.0;            ///< kernel volume ratio per pass, (j + alpha) / (j + 1)
+  double beta_t = -1.0;          ///< share of the shrinkage given to time (R^dims takes 1 - beta_t)
   TemporalKernel kernel = TemporalKernel::Epanechnikov;
 };
 

@@ -643,7 +643,7 @@ TEST_CASE("cli: bad integrator input exits 2 naming the key and value", "[cli]")
       {{"render", good, "--integrator", "photons", "--photons", "0"}, {"--photons", "0"}},
       {{"render", good, "--integrator", "photons", "--photon-radius", "0"}, {"--photon-radius", "0"}},
       {{"render", good, "--integrator", "photons", "--photon-bandwidth", "-1"}, {"--photon-bandwidth", "-1"}},
-      {{"render", good, "--integrator", "path", "--photons", "1000"}, {"--photons", "photon mapping only"}},
+      {{"render", good, "--integrator", "path", "--photons", "1000"}, {"--photons", "photon mapping and photon beams only"}},
       {{"render", good, "--light-paths", "1000", "--integrator", "path"}, {"--light-paths"}},
       {{"render", good, "--integrator", "light", "--reconstruction", "kernel"}, {"light", "kernel film"}},
       {{"render", with("k1.json", [](json& t) { t["render"]["integrator"] = "photon"; })},

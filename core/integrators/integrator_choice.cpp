@@ -16,6 +16,8 @@ const char* integrator_name(IntegratorKind kind) {
       return "light";
     case IntegratorKind::Photons:
       return "photons";
+    case IntegratorKind::Beams:
+      return "beams";
   }
   return "?";
 }
@@ -45,13 +47,17 @@ IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, s
   return IntegratorKind::Photons;
 }
 
-double default_photon_radius(const Scene& scene) {
+PhotonDesc progressive_settings(const Scene& scene, IntegratorKind kind, PhotonDesc p) {
+  const bool beams = kind == IntegratorKind::Beams;
   const double diag = length(scene.geometry().bounds_max() - scene.geometry().bounds_min());
-  return 0.005 * (diag > 0 ? diag : 1.0);
-}
-
-double default_photon_bandwidth(const SceneDesc& scene) {
-  return scene.time.bin_width_ps;
+  if (p.per_pass <= 0) p.per_pass = beams ? 20000 : 200000;
+  if (p.radius <= 0) p.radius = (beams ? 0.01 : 0.005) * (diag > 0 ? diag : 1.0);
+  if (p.bandwidth_ps <= 0) p.bandwidth_ps = scene.desc().time.bin_width_ps;
+  // Photons: bias R^2 + T^2 with R^2 T shrinking balances at beta_t = 1/3 and the MSE is best at
+  // alpha = 4/7; beams: bias R^2 + T^2 with R T shrinking balances at 1/2, best alpha 2/3.
+  if (p.alpha <= 0) p.alpha = beams ? 2.0 / 3.0 : 4.0 / 7.0;
+  if (p.beta_t < 0) p.beta_t = beams ? 0.5 : 1.0 / 3.0;
+  return p;
 }
 
 }  // namespace femto

@@ -46,6 +46,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
                 fy, out, stats);
         return true;
       }
+      case LightVertex::Kind::Segment:
+        return true;
       case LightVertex::Kind::Medium:
         splat(v.p, v.medium, w, dist, v.beta * (hg_eval(dot(v.d, w), v.g) * W), v.t_ps, v.sigma_ps,
               fx, fy, out, stats);

@@ -11,24 +11,27 @@
 
 namespace femto {
 
+/// `dims` is the spatial kernel's dimension: 2 for photons on surfaces (a disc), 1 for photon
+/// beams (a 1-D kernel across the beam); the kernel volume is R^dims T.
 class PpmSchedule {
  public:
-  PpmSchedule(double radius_1, double bandwidth_1, double alpha, double beta_t)
-      : r2_(radius_1 * radius_1), T_(bandwidth_1), alpha_(alpha), beta_t_(beta_t) {}
+  PpmSchedule(double radius_1, double bandwidth_1, double alpha, double beta_t, int dims = 2)
+      : R_(radius_1), T_(bandwidth_1), alpha_(alpha), beta_t_(beta_t), dims_(dims) {}
 
   int pass() const { return j_; }  ///< current pass, from 1
-  double radius() const { return std::sqrt(r2_); }
+  double radius() const { return R_; }
   double bandwidth() const { return T_; }
   void advance() {
     const double ratio = (j_ + alpha_) / (j_ + 1.0);
-    r2_ *= std::pow(ratio, 1.0 - beta_t_);
+    R_ *= std::pow(ratio, (1.0 - beta_t_) / dims_);
     T_ *= std::pow(ratio, beta_t_);
     ++j_;
   }
 
  private:
   int j_ = 1;
-  double r2_, T_, alpha_, beta_t_;
+  double R_, T_, alpha_, beta_t_;
+  int dims_;
 };
 
 }  // namespace femto

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "core/constants.h"
+#include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
 #include "core/sampling.h"
 #include "media/phase_hg.h"
@@ -101,7 +102,7 @@ void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceH
 }
 
 void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats,
-                              const PhotonGather* photons) const {
+                              const PhotonGather* photons, const BeamGather* beams) const {
   const auto& media = scene_.media();
   const auto& shapes = scene_.desc().shapes;
   const LightSet& lights = scene_.lights();
@@ -122,65 +123,80 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   // through one or more non-diffuse surfaces belongs to the photons. 0: no diffuse vertex yet or
   // a medium event since; 1: just left a diffuse vertex; 2: non-diffuse surfaces since it.
   int caustic_chain = 0;
+  // Photon beams own the paths whose first non-specular vertex from the camera is in a medium.
+  bool beam_prefix = beams != nullptr;
 
   for (;;) {
     SurfaceHit hit;
     const bool found = scene_.geometry().intersect(ray, 0.0, kInf, hit);
     const double s_surf = found ? hit.s : kInf;
     const Medium& med = media[static_cast<size_t>(m)];
-    const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next);
-    const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
-    const bool segment_connections =
-        med.connection != ConnectionSampling::Collision && !point_lights_.empty();
-    if (segment_connections && depth < max_depth_)
-      estimate_segment(med, m, ray, s_surf, beta, t, t_dropped, rng, acc, stats);
-    // Angular direction sampling: the next segment's distance draw is made now so that every
-    // strategy's MIS weight at this segment's vertices sees the same r_aux.
-    const bool angular = med.direction == DirectionSampling::Angular && !point_lights_.empty() &&
-                         ms.main.collided && depth < max_depth_;
-    u_next = angular ? rng.uniform() : -1.0;
-    const double t_main = t + ms.main.opl * t_dropped;
-    const DirectionMix mix_main =
-        angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next) : DirectionMix{};
-    if (ms.extra.collided && depth < max_depth_) {
-      // The time-uniform collision of MIS: next-event estimation only (the path goes on from
-      // the mean-free-path collision).
-      const Vec3 x2 = ray.at(ms.extra.s);
-      const double t2 = t + ms.extra.opl * t_dropped;
-      const DirectionMix mix2 = angular ? direction_mix(med, x2, t2, u_next) : DirectionMix{};
-      estimate_direct_medium(x2, m, ray.d, med.g(),
-                             beta * (MediumTracker::albedo_at(med, x2) * ms.extra_nee_weight), t2,
-                             angular ? &mix2 : nullptr, segment_connections, rng, acc, stats);
-    }
-    const DistanceEvent& ev = ms.main;
-    if (!ev.collided && !found) break;  // escaped to infinity
-    beta *= ev.weight;
-    t += ev.opl * t_dropped;
-    if (t > t_cut_) break;
-
-    if (ev.collided) {
-      // Real collision: absorb by weighting with the single-scattering albedo.
-      on_camera_segment = false;
-      caustic_chain = 0;
-      ++stats.medium_events;
-      if (depth >= max_depth_) {
-        ++stats.max_depth_hits;
-        break;
+    if (beams && beam_prefix && med.interacts()) {
+      // Before the first non-specular surface, light scattered in a medium comes from the beams:
+      // the camera path passes through with the segment's exact transmittance.
+      const double t_seg = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
+      beams->gather(m, ray, s_surf, beta, t, t_seg, acc, stats);
+      if (!found) break;
+      double tau, opl;
+      tracker_.segment_integrals(m, ray, s_surf, tau, opl);
+      beta *= std::exp(-tau);
+      t += opl * t_seg;
+      if (t > t_cut_ || beta.is_black()) break;
+    } else {
+      const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next);
+      const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
+      const bool segment_connections =
+          med.connection != ConnectionSampling::Collision && !point_lights_.empty();
+      if (segment_connections && depth < max_depth_)
+        estimate_segment(med, m, ray, s_surf, beta, t, t_dropped, rng, acc, stats);
+      // Angular direction sampling: the next segment's distance draw is made now so that every
+      // strategy's MIS weight at this segment's vertices sees the same r_aux.
+      const bool angular = med.direction == DirectionSampling::Angular && !point_lights_.empty() &&
+                           ms.main.collided && depth < max_depth_;
+      u_next = angular ? rng.uniform() : -1.0;
+      const double t_main = t + ms.main.opl * t_dropped;
+      const DirectionMix mix_main =
+          angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next) : DirectionMix{};
+      if (ms.extra.collided && depth < max_depth_) {
+        // The time-uniform collision of MIS: next-event estimation only (the path goes on from
+        // the mean-free-path collision).
+        const Vec3 x2 = ray.at(ms.extra.s);
+        const double t2 = t + ms.extra.opl * t_dropped;
+        const DirectionMix mix2 = angular ? direction_mix(med, x2, t2, u_next) : DirectionMix{};
+        estimate_direct_medium(x2, m, ray.d, med.g(),
+                               beta * (MediumTracker::albedo_at(med, x2) * ms.extra_nee_weight), t2,
+                               angular ? &mix2 : nullptr, segment_connections, rng, acc, stats);
       }
-      ++depth;
-      const Vec3 x = ray.at(ev.s);
-      beta *= MediumTracker::albedo_at(med, x);
-      if (beta.is_black()) break;
-      estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t,
-                             angular ? &mix_main : nullptr, segment_connections, rng, acc, stats);
-      Vec3 wi;
-      beta *=
-          sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone
-      if (beta.is_black()) break;
-      specular = false;
-      prev_p = x;
-      ray = {x, wi};
-      continue;
+      const DistanceEvent& ev = ms.main;
+      if (!ev.collided && !found) break;  // escaped to infinity
+      beta *= ev.weight;
+      t += ev.opl * t_dropped;
+      if (t > t_cut_) break;
+
+      if (ev.collided) {
+        // Real collision: absorb by weighting with the single-scattering albedo.
+        on_camera_segment = false;
+        caustic_chain = 0;
+        ++stats.medium_events;
+        if (depth >= max_depth_) {
+          ++stats.max_depth_hits;
+          break;
+        }
+        ++depth;
+        const Vec3 x = ray.at(ev.s);
+        beta *= MediumTracker::albedo_at(med, x);
+        if (beta.is_black()) break;
+        estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t,
+                               angular ? &mix_main : nullptr, segment_connections, rng, acc, stats);
+        Vec3 wi;
+        beta *=
+            sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone
+        if (beta.is_black()) break;
+        specular = false;
+        prev_p = x;
+        ray = {x, wi};
+        continue;
+      }
     }
 
     // Surface interaction.
@@ -220,6 +236,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     if (!bsdf.is_delta() && !(photons && !bsdf.is_diffuse() && caustic_chain > 0))
       estimate_direct_surface(bsdf, hit, frame, wo, wo_outside, beta, t, rng, acc, stats);
     if (photons) caustic_chain = bsdf.is_diffuse() ? 1 : (caustic_chain > 0 ? 2 : 0);
+    if (!bsdf.is_delta()) beam_prefix = false;
 
     BsdfSample bs;
     const double u_lobe = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();

@@ -19,6 +19,7 @@
 namespace femto {
 
 struct PhotonGather;
+struct BeamGather;
 
 class VolPathIntegrator {
  public:
@@ -27,8 +28,10 @@ class VolPathIntegrator {
   /// Traces one camera path starting on `ray` (in the outside medium) and adds its
   /// contributions to `acc`. With `photons`, caustic paths (light -> non-diffuse surfaces ->
   /// diffuse surface) come from the photons gathered at diffuse vertices, not from this path.
+  /// With `beams`, light scattered in a medium before the path's first non-specular surface
+  /// comes from photon beams gathered along those segments.
   void trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats,
-             const PhotonGather* photons = nullptr) const;
+             const PhotonGather* photons = nullptr, const BeamGather* beams = nullptr) const;
 
   /// Path time beyond which no contribution can reach the window, ps.
   double time_cutoff_ps() const { return t_cut_; }

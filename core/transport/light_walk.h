@@ -18,7 +18,7 @@ namespace femto {
 
 /// One vertex of a light sub-path, as handed to the visitor.
 struct LightVertex {
-  enum class Kind { Emitter, Surface, Medium };
+  enum class Kind { Emitter, Surface, Medium, Segment };
   Kind kind = Kind::Medium;
   Vec3 p;                           ///< position
   Vec3 d;                           ///< propagation direction of the path arriving at p
@@ -35,6 +35,12 @@ struct LightVertex {
   /// Non-diffuse surfaces met since emission, or -1 once the path has scattered in a medium or
   /// off a diffuse surface (the caustic-path test of the photon partition).
   int chain = 0;
+  /// Segment (photon beams): the straight piece of path in a scattering medium that starts at p
+  /// along d, up to the next collision sampled by mean free path or the next surface (infinite if
+  /// it escapes); beta and t_ps are at its start. Mean-free-path sampling makes the chance of the
+  /// segment reaching s exactly the transmittance to s, so a beam needs no transmittance of its
+  /// own.
+  double length = 0;
   /// A medium vertex for connections only (the time-uniform collision of MIS distance sampling):
   /// the path does not continue from it.
   bool connection_only = false;
@@ -50,10 +56,11 @@ inline int medium_at_origin(const Scene& scene, const Ray& ray) {
 
 /// Traces one light sub-path from a light picked by power. `visit(const LightVertex&)` returns
 /// whether the path goes on. Paths stop at t_cut_ps, at max_depth scattering vertices (counted),
-/// or when the visitor stops them.
+/// or when the visitor stops them. With `segments`, distances in media are sampled by mean free
+/// path whatever the medium's strategy, and every segment in a scattering medium is visited too.
 template <class Visitor>
 void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng, int max_depth,
-                     double t_cut_ps, PathStats& stats, Visitor&& visit) {
+                     double t_cut_ps, PathStats& stats, Visitor&& visit, bool segments = false) {
   const LightSet& lights = scene.lights();
   const auto& media = scene.media();
   const auto& shapes = scene.desc().shapes;
@@ -89,8 +96,29 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
     const bool found =
         scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit);
     const double s_surf = found ? hit.s : std::numeric_limits<double>::infinity();
-    const Medium& med = media[static_cast<size_t>(m)];
+    const Medium& region = media[static_cast<size_t>(m)];
+    Medium mfp_copy;
+    if (segments) {
+      mfp_copy = region;
+      mfp_copy.strategy.kind = DistanceSampling::Mfp;
+    }
+    const Medium& med = segments ? mfp_copy : region;
     const MediumSample ms = tracker.sample(med, ray, s_surf, rng);
+    const bool scatters = med.type == Medium::Type::Grid || med.homogeneous.sigma_s > 0;
+    if (segments && scatters) {
+      LightVertex sg;
+      sg.kind = LightVertex::Kind::Segment;
+      sg.p = ray.o;
+      sg.d = ray.d;
+      sg.medium = m;
+      sg.g = med.g();
+      sg.beta = beta;
+      sg.t_ps = t;
+      sg.sigma_ps = v.sigma_ps;
+      sg.chain = chain;
+      sg.length = ms.main.s;
+      visit(static_cast<const LightVertex&>(sg));
+    }
     if (ms.extra.collided && depth < max_depth) {
       const Vec3 x2 = ray.at(ms.extra.s);
       LightVertex c;

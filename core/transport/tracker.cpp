@@ -22,6 +22,8 @@ PathStats& PathStats::operator+=(const PathStats& o) {
   light_paths += o.light_paths;
   photons_stored += o.photons_stored;
   photon_gathers += o.photon_gathers;
+  beams_stored += o.beams_stored;
+  beam_gathers += o.beam_gathers;
   return *this;
 }
 

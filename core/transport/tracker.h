@@ -19,6 +19,8 @@ struct PathStats {
   uint64_t light_paths = 0;        ///< light sub-paths (light tracing and photons)
   uint64_t photons_stored = 0;     ///< photons kept for gathering
   uint64_t photon_gathers = 0;     ///< camera vertices that gathered photons
+  uint64_t beams_stored = 0;       ///< photon-beam segments kept for gathering
+  uint64_t beam_gathers = 0;       ///< beam crossings that added to the image
   PathStats& operator+=(const PathStats& o);
 };
 

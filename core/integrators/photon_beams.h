@@ -1,0 +1,102 @@
+#pragma once
+// Transient photon beams (Jarosz et al. 2011, beam x beam with a 1-D kernel; in time as in
+// seed 000 Sec. 6 and Marco et al. 2019): every light-path segment in a scattering medium is a
+// beam, and a camera ray through the medium gathers the beams that pass within R of it at their
+// closest approach:
+//   L += beta_c T_c(t) sigma_s(x) f_p(cos) Phi_b / (2 R sin(theta) N),
+// deposited at t_camera(t) + t_beam(v) through the temporal kernel K_T. Beams are "short": a
+// segment ends at its mean-free-path collision, so the chance that it reaches v is the
+// transmittance to v and the beam carries no transmittance of its own.
+#include <cstdint>
+#include <vector>
+
+#include "core/pixel_accumulator.h"
+#include "core/scene.h"
+#include "core/temporal_filter.h"
+#include "core/transport/tracker.h"
+
+namespace femto {
+
+struct Beam {
+  Vec3 o;               ///< start
+  Vec3 d;               ///< unit direction of travel
+  double length = 0;    ///< to the next collision or surface (may be infinite), mm
+  RGB power;            ///< flux weight at the start (divide by the light paths of the pass)
+  double t_ps = 0;      ///< emission time + flight time to the start
+  double sigma_ps = 0;  ///< pulse std of its light
+  double g = 0;         ///< HG asymmetry of its medium
+  int medium = 0;       ///< region it lies in
+};
+
+/// Bounding-volume hierarchy over beams thickened by R, for segment queries; built per pass.
+class BeamBvh {
+ public:
+  /// Beams must be finite (trace_beams clips them where their time passes the window end).
+  void build(std::vector<Beam> beams, double radius);
+  /// Calls f(const Beam&) for every beam whose thickened box the segment o + t d, t in [0, t_max),
+  /// meets.
+  template <class F>
+  void query(const Vec3& o, const Vec3& d, double t_max, F&& f) const;
+  size_t size() const { return beams_.size(); }
+  uint64_t memory_bytes() const;
+
+ private:
+  struct Node {
+    Vec3 lo, hi;
+    uint32_t first = 0, count = 0;  ///< leaf: beams [first, first + count); inner: count = 0
+    uint32_t left = 0, right = 0;
+  };
+  uint32_t build_node(uint32_t first, uint32_t count, std::vector<Vec3>& lo, std::vector<Vec3>& hi,
+                      std::vector<Vec3>& centre);
+  static bool hits(const Node& n, const Vec3& o, const Vec3& inv_d, double t_max);
+  std::vector<Beam> beams_;
+  std::vector<Node> nodes_;
+};
+
+/// What a camera ray needs to gather one pass's beams.
+struct BeamGather {
+  const BeamBvh* bvh = nullptr;
+  const Scene* scene = nullptr;
+  const MediumTracker* tracker = nullptr;
+  double radius = 1;        ///< R_j, mm
+  double bandwidth_ps = 0;  ///< T_j, ps
+  double inv_paths = 1;     ///< 1 / light paths traced in the pass
+  TemporalFilter kernel;
+  /// Adds the in-scattered radiance from beams along [0, s_max) of `ray` in medium m, seen with
+  /// throughput beta from camera time t (t_factor converts OPL to time on this segment: 0 on an
+  /// unwarped camera segment).
+  void gather(int m, const Ray& ray, double s_max, const RGB& beta, double t, double t_factor,
+              PixelAccumulator& acc, PathStats& stats) const;
+};
+
+/// Traces `count` light paths of one pass and returns their beams in path order (the same list
+/// for any thread count).
+std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64_t count,
+                              int max_depth, double t_cut_ps, PathStats& stats);
+
+/// Memory of one pass holding `beams` beams: the traced lists and the tree's copy, the build's
+/// boxes and centres, and the nodes (at most one per beam).
+inline uint64_t beam_pass_bytes(uint64_t beams) {
+  return beams * (3 * sizeof(Beam) + 3 * sizeof(Vec3) + 64);
+}
+
+template <class F>
+void BeamBvh::query(const Vec3& o, const Vec3& d, double t_max, F&& f) const {
+  if (nodes_.empty()) return;
+  const Vec3 inv_d(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+  uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (!hits(n, o, inv_d, t_max)) continue;
+    if (n.count > 0) {
+      for (uint32_t i = n.first; i < n.first + n.count; ++i) f(beams_[i]);
+    } else if (top + 2 <= 64) {
+      stack[top++] = n.left;
+      stack[top++] = n.right;
+    }
+  }
+}
+
+}  // namespace femto

@@ -1,0 +1,269 @@
+// Photon beams: agreement with camera paths for all light scattered in a medium, the
+// progressive schedule's bias shrinking, and determinism.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include "core/integrators/photon_beams.h"
+#include "core/integrators/ppm_schedule.h"
+#include "core/scene_loader.h"
+#include "media/volume_data.h"
+#include "samplers/stats.h"
+#include "scene_builders.h"
+#include "temp_dir.h"
+
+using namespace femto;
+using namespace femto::test;
+
+namespace {
+
+// Fog in a box (clear of the walls and of the camera) with a point light inside, a floor and a
+// back wall.
+SceneDesc fog_box(int w, int h) {
+  SceneDesc d = load_scene_string(R"({
+    "camera": { "type": "perspective", "position": [0, 30, 140], "look_at": [0, 25, 0], "fov": 45,
+                "resolution": [16, 12] },
+    "time": { "t_start": 350, "bin_width": 75, "bins": 12 },
+    "media": { "fog": { "type": "homogeneous", "sigma_a": 0.004, "sigma_s": 0.02, "g": 0.4, "eta": 1.33,
+                        "connection_sampling": "mis" } },
+    "shapes": [
+      { "type": "box", "min": [-59, 1, -59], "max": [59, 80, 59], "medium": "fog" },
+      { "type": "quad", "corner": [-60, 0, 60], "edge1": [120, 0, 0], "edge2": [0, 0, -120],
+        "material": { "type": "diffuse", "albedo": 0.7 } },
+      { "type": "quad", "corner": [-60, 0, -60], "edge1": [120, 0, 0], "edge2": [0, 80, 0],
+        "material": { "type": "diffuse", "albedo": 0.5 } }
+    ],
+    "lights": [ { "type": "point", "position": [10, 40, -10], "intensity": 1000 } ]
+  })",
+                                  "fog box", ".");
+  d.camera.width = w;
+  d.camera.height = h;
+  return d;
+}
+
+std::vector<TransientFilm> runs(const Scene& scene, IntegratorKind kind, int spp, int n,
+                                uint64_t seed0, const PhotonDesc& pd = {}) {
+  std::vector<TransientFilm> films;
+  for (int b = 0; b < n; ++b) {
+    RenderOptions opt;
+    opt.integrator = kind;
+    opt.spp = spp;
+    opt.photons = pd;
+    opt.seed = seed0 + static_cast<uint64_t>(b);
+    opt.threads = 2;
+    opt.quiet = true;
+    films.push_back(render(scene, opt).film);
+  }
+  return films;
+}
+
+/// Per-batch sums over blocks of pixels and groups of bins (all channels): cells[c][batch].
+std::vector<std::vector<double>> cells(const std::vector<TransientFilm>& films, int block,
+                                       int group) {
+  const TransientFilm& f0 = films.front();
+  const int bx = (f0.width() + block - 1) / block, by = (f0.height() + block - 1) / block;
+  const int bt = (f0.bins() + group - 1) / group;
+  std::vector<std::vector<double>> out(static_cast<size_t>(bx * by * bt),
+                                       std::vector<double>(films.size(), 0.0));
+  for (size_t b = 0; b < films.size(); ++b)
+    for (int y = 0; y < f0.height(); ++y)
+      for (int x = 0; x < f0.width(); ++x)
+        for (int t = 0; t < f0.bins(); ++t) {
+          const size_t i =
+              ((static_cast<size_t>(y) * static_cast<size_t>(f0.width()) + static_cast<size_t>(x)) *
+                   static_cast<size_t>(f0.bins()) +
+               static_cast<size_t>(t)) *
+              3;
+          const size_t c = static_cast<size_t>(((y / block) * bx + x / block) * bt + t / group);
+          const float* v = films[b].transient();
+          out[c][b] += static_cast<double>(v[i]) + v[i + 1] + v[i + 2];
+        }
+  return out;
+}
+
+}  // namespace
+
+// Catches: a wrong beam estimator (the 1 / sin(theta) factor, the 1-D kernel's 1 / (2R), the phase
+// function's direction, transmittance along the camera ray, sigma_s at the crossing), beam times
+// (OPL along the beam and the camera ray), or paths counted twice or lost between beams and
+// camera paths: all light scattered in the fog comes from beams here, and must match camera paths
+// cell by cell within 4 combined standard errors.
+TEST_CASE("photon beams agree with camera paths in a fog box, bin by bin", "[beams]") {
+  const Scene scene(fog_box(16, 12));
+  PhotonDesc pd;
+  pd.per_pass = 4000;
+  pd.radius =
+      0.5;  // small against the 4 x 4 pixel blocks compared: kernel bias far below the noise
+  pd.bandwidth_ps = 1.0;
+  const auto pt = cells(runs(scene, IntegratorKind::Path, 128, 24, 100), 4, 3);
+  const auto bm = cells(runs(scene, IntegratorKind::Beams, 16, 24, 200, pd), 4, 3);
+  double peak = 0;
+  for (const auto& c : pt) peak = std::max(peak, mean_se(c).mean);
+  int compared = 0;
+  double chi2 = 0, max_z = 0, total = 0, var_pt = 0, var_bm = 0;
+  for (size_t c = 0; c < pt.size(); ++c) {
+    const MeanSE a = mean_se(pt[c]), b = mean_se(bm[c]);
+    total += a.mean;
+    var_pt += a.se * a.se;
+    var_bm += b.se * b.se;
+    if (std::max(a.mean, b.mean) < 0.02 * peak) continue;
+    const double z = (a.mean - b.mean) / std::sqrt(a.se * a.se + b.se * b.se);
+    chi2 += z * z;
+    max_z = std::max(max_z, std::abs(z));
+    ++compared;
+  }
+  INFO("cells " << compared << ", max |z| " << max_z << ", chi2 " << chi2
+                << ", relative SE of the total: path " << std::sqrt(var_pt) / total << ", beams "
+                << std::sqrt(var_bm) / total);
+  REQUIRE(compared >= 15);
+  CHECK(max_z < 4.0);
+  CHECK(stats::chi2_survival(chi2, compared) > 1e-3);
+  CHECK(std::sqrt(var_pt + var_bm) / total < 0.02);  // an 8% error would be 4 standard errors
+}
+
+// Catches: a schedule that does not shrink the beam radius (or shrinks R^2 instead of R): the
+// kernel volume R T must fall by (j + alpha) / (j + 1) per pass.
+TEST_CASE("beam radius and bandwidth follow the 1-D schedule", "[beams]") {
+  const double alpha = 2.0 / 3.0, beta_t = 0.5;
+  PpmSchedule s(3.0, 10.0, alpha, beta_t, 1);
+  double volume = 30.0;
+  for (int j = 1; j < 100; ++j) {
+    s.advance();
+    volume *= (j + alpha) / (j + 1.0);
+    CHECK(s.radius() * s.bandwidth() == Approx(volume).epsilon(1e-12));
+    CHECK(s.radius() / 3.0 ==
+          Approx(s.bandwidth() / 10.0).epsilon(1e-12));  // beta_t = 1/2: equal shares
+  }
+}
+
+// Catches: beam-kernel bias that stays: near the point light the fluence falls off fast, so a
+// wide fixed beam radius blurs light away from the beams' cores; shrinking radii must move the
+// estimate of the brightest region towards the camera-path answer.
+TEST_CASE("the beam estimate's bias shrinks as passes go on", "[beams]") {
+  SceneDesc d = fog_box(16, 12);
+  d.time.t_start_ps = 0;
+  d.time.bin_width_ps = 3000;
+  d.time.bins = 1;
+  const Scene scene(d);
+  // The brightest 2 x 2 block of the camera-path answer (around the light).
+  const auto ref_films = runs(scene, IntegratorKind::Path, 512, 12, 300);
+  auto px = [&](const TransientFilm& f, int x, int y) {
+    return f.steady()[3 * static_cast<size_t>(y * 16 + x) + 1];
+  };
+  int bx = 0, by = 0;
+  double best = -1;
+  for (int y = 0; y + 1 < 12; ++y)
+    for (int x = 0; x + 1 < 16; ++x) {
+      double s = 0;
+      for (const auto& f : ref_films)
+        s += px(f, x, y) + px(f, x + 1, y) + px(f, x, y + 1) + px(f, x + 1, y + 1);
+      if (s > best) best = s, bx = x, by = y;
+    }
+  auto block = [&](const TransientFilm& f) {
+    return px(f, bx, by) + px(f, bx + 1, by) + px(f, bx, by + 1) + px(f, bx + 1, by + 1);
+  };
+  std::vector<double> ref, a, b;
+  for (const auto& f : ref_films) ref.push_back(block(f));
+  PhotonDesc fixed;
+  fixed.per_pass = 2000;
+  fixed.radius = 12.0;
+  fixed.bandwidth_ps = 1.0;
+  fixed.alpha = 1.0;  // no shrinking
+  PhotonDesc progressive = fixed;
+  progressive.alpha = 0.2;  // fast shrinking, to resolve the change within a short test
+  for (const auto& f : runs(scene, IntegratorKind::Beams, 32, 8, 400, fixed)) a.push_back(block(f));
+  for (const auto& f : runs(scene, IntegratorKind::Beams, 32, 8, 500, progressive))
+    b.push_back(block(f));
+  const MeanSE r = mean_se(ref), fa = mean_se(a), fb = mean_se(b);
+  const double bias_fixed = fa.mean - r.mean, bias_prog = fb.mean - r.mean;
+  INFO("block " << bx << "," << by << ": camera paths " << r.mean << " +- " << r.se << ", fixed R "
+                << fa.mean << " +- " << fa.se << ", shrinking R " << fb.mean << " +- " << fb.se);
+  REQUIRE(std::abs(bias_fixed) > 4.0 * std::hypot(fa.se, r.se));
+  CHECK(std::abs(bias_prog) < 0.6 * std::abs(bias_fixed));
+}
+
+// Catches: beam order (and so the tree and the sums) depending on how work is split.
+TEST_CASE("photon beams are bit-identical for 1 and 2 threads", "[beams]") {
+  const Scene scene(fog_box(12, 10));
+  std::vector<std::vector<float>> out;
+  for (int threads : {1, 2}) {
+    RenderOptions opt;
+    opt.integrator = IntegratorKind::Beams;
+    opt.spp = 3;
+    opt.photons.per_pass = 1000;
+    opt.threads = threads;
+    opt.quiet = true;
+    const RenderResult res = render(scene, opt);
+    const float* v = res.film.transient();
+    out.emplace_back(
+        v, v + static_cast<size_t>(res.film.width() * res.film.height() * res.film.bins() * 3));
+  }
+  CHECK(out[0] == out[1]);
+}
+
+// Catches: beam times that ignore the per-voxel index (OPL along the beam and along the camera
+// ray) or sigma_s read at the wrong place in a heterogeneous medium.
+TEST_CASE("photon beams agree with camera paths in a voxel medium with per-voxel eta", "[beams]") {
+  TempDir tmp("femto_beams");
+  const int n = 12;
+  DenseGrid density(n, n, n, 0.0f), eta(n, n, n, 1.0f);
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const size_t i =
+            (static_cast<size_t>(z) * n + static_cast<size_t>(y)) * n + static_cast<size_t>(x);
+        density.v[i] = 0.01f + 0.004f * static_cast<float>(x + y);
+        eta.v[i] = 1.0f + 0.05f * static_cast<float>(z);
+      }
+  density.update_range();
+  eta.update_range();
+  const std::string file = (tmp.dir / "eta.vdb").string();
+  write_volume(file, density, nullptr, &eta, 5.0, {-30, 0, -30});
+  SceneDesc d = fog_box(16, 12);
+  d.shapes.erase(d.shapes.begin());  // no fog box: the voxel medium fills everything
+  d.media.clear();
+  MediumDesc m;
+  m.name = "vdb";
+  m.type = MediumDesc::Type::Vdb;
+  m.vdb.file = file;
+  m.vdb.albedo = 0.85;
+  m.vdb.eta = 1.0;
+  m.vdb.eta_grid = "eta";
+  m.medium.g = 0.2;
+  d.media.push_back(m);
+  d.global_medium = 0;
+  for (auto& s : d.shapes) s.interior_medium = -1;
+  d.lights.front().position = {0, 80, 0};  // above the grid
+  d.lights.front().intensity = RGB(3000.0);
+  d.time.t_start_ps = 300;
+  d.time.bin_width_ps = 100;
+  d.time.bins = 10;
+  const Scene scene(d);
+  PhotonDesc pd;
+  pd.per_pass = 4000;
+  pd.radius = 0.5;
+  pd.bandwidth_ps = 1.0;
+  const auto pt = cells(runs(scene, IntegratorKind::Path, 96, 16, 600), 4, 2);
+  const auto bm = cells(runs(scene, IntegratorKind::Beams, 16, 16, 700, pd), 4, 2);
+  double peak = 0;
+  for (const auto& c : pt) peak = std::max(peak, mean_se(c).mean);
+  int compared = 0;
+  double chi2 = 0, max_z = 0, total = 0, var = 0;
+  for (size_t c = 0; c < pt.size(); ++c) {
+    const MeanSE a = mean_se(pt[c]), b = mean_se(bm[c]);
+    total += a.mean;
+    var += a.se * a.se + b.se * b.se;
+    if (std::max(a.mean, b.mean) < 0.02 * peak) continue;
+    const double z = (a.mean - b.mean) / std::sqrt(a.se * a.se + b.se * b.se);
+    chi2 += z * z;
+    max_z = std::max(max_z, std::abs(z));
+    ++compared;
+  }
+  INFO("cells " << compared << ", max |z| " << max_z << ", chi2 " << chi2
+                << ", relative SE of the total " << std::sqrt(var) / total);
+  REQUIRE(compared >= 10);
+  CHECK(max_z < 4.0);
+  CHECK(stats::chi2_survival(chi2, compared) > 1e-3);
+  CHECK(std::sqrt(var) / total < 0.02);
+}
