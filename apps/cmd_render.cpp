@@ -152,7 +152,8 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why, cons
       j["light_paths"] = result.light_paths;
       break;
     case IntegratorKind::Photons:
-    case IntegratorKind::Beams: {
+    case IntegratorKind::Beams:
+    case IntegratorKind::Hybrid: {
       const bool beams = kind == IntegratorKind::Beams;
       const auto& p = result.photons;
       j["description"] =
@@ -173,6 +174,16 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why, cons
       j["schedule"] = beams ? "R_{j+1} = R_j ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_t"
                             : "R_{j+1}^2 = R_j^2 ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_t";
       j[beams ? "max_beams_stored_per_pass" : "max_photons_stored_per_pass"] = p.max_stored_per_pass;
+      if (p.hybrid_beams)
+        j["caustic_beams"] = {
+            {"description", "segments in media of light paths after one or more non-diffuse surfaces"},
+            {"light_paths_per_pass", p.beam_paths},
+            {"radius_mm", {{"first_pass", p.beam_radius_first}, {"after_last_pass", p.beam_radius_last}}},
+            {"bandwidth_ps", {{"first_pass", p.beam_bandwidth_first_ps}, {"after_last_pass", p.beam_bandwidth_last_ps}}},
+            {"alpha", p.beam_alpha},
+            {"beta_t", p.beam_beta_t},
+            {"spatial_kernel", "1-D across the beam, 1 / (2 R), with 1 / sin(theta)"},
+            {"schedule", "R_{j+1} = R_j ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j + 1))^beta_t"}};
       j[beams ? "beam_memory_bytes_peak" : "photon_memory_bytes_peak"] = p.peak_photon_bytes;
       break;
     }
@@ -211,7 +222,7 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
             {"integrator", integrator_name(kind)},
             {"light_paths", kind == IntegratorKind::Light ? opt.light_paths : 0},
             {"photons",
-             kind != IntegratorKind::Photons && kind != IntegratorKind::Beams
+             kind != IntegratorKind::Photons && kind != IntegratorKind::Beams && kind != IntegratorKind::Hybrid
                  ? nlohmann::json(nullptr)
                  : nlohmann::json{{"per_pass", pd.per_pass},
                                   {"radius", pd.radius},
@@ -322,7 +333,8 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       else if (v == "light") integrator = IntegratorKind::Light;
       else if (v == "photons") integrator = IntegratorKind::Photons;
       else if (v == "beams") integrator = IntegratorKind::Beams;
-      else args.fail("expected auto, path, light, photons or beams", v);
+      else if (v == "hybrid") integrator = IntegratorKind::Hybrid;
+      else args.fail("expected auto, path, light, photons, beams or hybrid", v);
     } else if (a == "--light-paths") {
       light_paths = static_cast<int64_t>(args.int_value(1, 1000000000000LL));
     } else if (a == "--photons") {
@@ -410,10 +422,17 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     throw InputError(where + ": integrator \"" + integrator_name(kind) +
                      "\": the kernel film (/time/reconstruction kernel) works with camera paths only; use "
                      "--integrator path or the histogram film");
-  if (!photon_flag.empty() && kind != IntegratorKind::Photons && kind != IntegratorKind::Beams)
+  if (!photon_flag.empty() && kind != IntegratorKind::Photons && kind != IntegratorKind::Beams &&
+      kind != IntegratorKind::Hybrid)
     throw InputError("femto render: " + photon_flag +
                      ": applies to photon mapping and photon beams only, but the integrator is \"" +
                      integrator_name(kind) + "\"; add --integrator photons or beams");
+  const bool scattering = std::any_of(desc.media.begin(), desc.media.end(), [](const MediumDesc& m) {
+    return m.type == MediumDesc::Type::Vdb || m.medium.sigma_s > 0;
+  });
+  if (kind == IntegratorKind::Beams && !scattering)
+    throw InputError(where + ": integrator \"beams\": the scene has no scattering medium, so there are no beams "
+                             "to gather; use --integrator path, light or photons");
   if (light_paths && kind != IntegratorKind::Light)
     throw InputError("femto render: --light-paths: applies to --integrator light only");
   RenderOptions opt;

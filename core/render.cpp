@@ -98,7 +98,8 @@ void render_pixel(const Scene& scene, const VolPathIntegrator& integrator,
 
 RenderResult render(const Scene& scene, const RenderOptions& opt) {
   if (opt.integrator == IntegratorKind::Light) return render_light(scene, opt);
-  if (opt.integrator == IntegratorKind::Photons || opt.integrator == IntegratorKind::Beams)
+  if (opt.integrator == IntegratorKind::Photons || opt.integrator == IntegratorKind::Beams ||
+      opt.integrator == IntegratorKind::Hybrid)
     return render_photons(scene, opt);
   const auto start = std::chrono::steady_clock::now();
   const Camera& camera = scene.camera();
@@ -216,7 +217,7 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
                                      (sizeof(PixelAccumulator::Held) + sizeof(double))
                                : 0;
   m.per_thread = static_cast<uint64_t>(std::max(1, threads)) * (B * 3 * sizeof(double) + held);
-  if (opt.integrator == IntegratorKind::Photons)
+  if (opt.integrator == IntegratorKind::Photons || opt.integrator == IntegratorKind::Hybrid)
     m.integrator = photon_pass_bytes(opt.photons.per_pass > 0 ? opt.photons.per_pass : 200000);
   // Beams: an estimate (the beams a light path leaves depend on the scene), about 8 per path.
   if (opt.integrator == IntegratorKind::Beams)

@@ -74,6 +74,11 @@ struct RenderResult {
     int passes = 0;
     int64_t per_pass = 0;
     double alpha = 0, beta_t = 0;
+    /// Hybrid: the caustic beams' settings (the fields above are the photons').
+    bool hybrid_beams = false;
+    double beam_radius_first = 0, beam_radius_last = 0, beam_bandwidth_first_ps = 0, beam_bandwidth_last_ps = 0;
+    double beam_alpha = 0, beam_beta_t = 0;
+    int64_t beam_paths = 0;
     double radius_first = 0, radius_last = 0, bandwidth_first_ps = 0, bandwidth_last_ps = 0;
     uint64_t max_stored_per_pass = 0;
     uint64_t peak_photon_bytes = 0;  ///< largest photon list + grid of one pass

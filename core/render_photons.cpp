@@ -29,12 +29,19 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const TimeAxis axis = scene.desc().time;
   const TemporalFilter filter(axis, TemporalFilter::Kind::Histogram);
   const VolPathIntegrator integrator(scene, filter, opt.max_depth);
-  const IntegratorKind kind =
-      opt.integrator == IntegratorKind::Beams ? IntegratorKind::Beams : IntegratorKind::Photons;
-  const bool use_beams = kind == IntegratorKind::Beams;
-  const PhotonDesc pd = progressive_settings(scene, kind, opt.photons);
-  const double R1 = pd.radius, T1 = pd.bandwidth_ps;
-  PpmSchedule schedule(R1, T1, pd.alpha, pd.beta_t, use_beams ? 1 : 2);
+  const IntegratorKind kind = opt.integrator;
+  // Photons: photons on surfaces; beams: all beams; hybrid: photons and caustic beams.
+  const bool use_photons = kind != IntegratorKind::Beams;
+  const bool use_beams = kind != IntegratorKind::Photons;
+  const bool caustic_beams = kind == IntegratorKind::Hybrid;
+  const PhotonDesc pd = progressive_settings(
+      scene, kind == IntegratorKind::Beams ? IntegratorKind::Beams : IntegratorKind::Photons,
+      opt.photons);
+  const PhotonDesc bd = progressive_settings(scene, IntegratorKind::Beams, opt.photons);
+  const double R1 = use_photons ? pd.radius : bd.radius,
+               T1 = use_photons ? pd.bandwidth_ps : bd.bandwidth_ps;
+  PpmSchedule schedule(pd.radius, pd.bandwidth_ps, pd.alpha, pd.beta_t, use_photons ? 2 : 1);
+  PpmSchedule beam_schedule(bd.radius, bd.bandwidth_ps, bd.alpha, bd.beta_t, 1);
   const MediumTracker tracker(scene);
   // Photon times include the emission offset: the window end plus the widest pulse spread.
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
@@ -43,7 +50,10 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   // A pass is one photon pass (and one camera sample per pixel); the schedule's state is the
   // pass index, so a resumed render replays it.
   RenderState state = passes::start_state(opt, kind, false, pixels, axis.bins, opt.spp);
-  for (int64_t i = 0; i < state.units_done; ++i) schedule.advance();
+  for (int64_t i = 0; i < state.units_done; ++i) {
+    schedule.advance();
+    beam_schedule.advance();
+  }
   const size_t stride = static_cast<size_t>(state.stride);
   const size_t nb = static_cast<size_t>(axis.bins) * 3;
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
@@ -63,34 +73,39 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       const int pass = static_cast<int>(state.units_done);
       PathStats photon_stats;
       BeamGather beam_gather;
+      uint64_t pass_bytes = 0;
       if (use_beams) {
-        std::vector<Beam> beams = trace_beams(scene, opt.seed, pass, pd.per_pass, opt.max_depth,
-                                              photon_t_cut, photon_stats);
+        const int64_t paths = bd.per_pass;
+        std::vector<Beam> beams = trace_beams(scene, opt.seed, pass, paths, opt.max_depth,
+                                              photon_t_cut, photon_stats, caustic_beams);
         state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, beams.size());
-        bvh.build(std::move(beams), schedule.radius());
-        state.photon_peak_bytes = std::max(state.photon_peak_bytes, bvh.memory_bytes());
+        bvh.build(std::move(beams), beam_schedule.radius());
+        pass_bytes += bvh.memory_bytes();
         beam_gather.bvh = &bvh;
         beam_gather.scene = &scene;
         beam_gather.tracker = &tracker;
-        beam_gather.radius = schedule.radius();
-        beam_gather.bandwidth_ps = schedule.bandwidth();
-        beam_gather.inv_paths = 1.0 / static_cast<double>(pd.per_pass);
-        beam_gather.kernel = TemporalFilter(axis, TemporalFilter::Kind::Kernel, pd.kernel);
-      } else {
+        beam_gather.radius = beam_schedule.radius();
+        beam_gather.bandwidth_ps = beam_schedule.bandwidth();
+        beam_gather.inv_paths = 1.0 / static_cast<double>(paths);
+        beam_gather.kernel = TemporalFilter(axis, TemporalFilter::Kind::Kernel, bd.kernel);
+        beam_gather.caustic_only = caustic_beams;
+      }
+      if (use_photons) {
         std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass,
                                                     opt.max_depth, photon_t_cut, photon_stats);
         state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());
         grid.build(std::move(photons), schedule.radius());
-        state.photon_peak_bytes = std::max(state.photon_peak_bytes, grid.memory_bytes());
+        pass_bytes += grid.memory_bytes();
       }
+      state.photon_peak_bytes = std::max(state.photon_peak_bytes, pass_bytes);
       PhotonGather gather;
       gather.grid = &grid;
       gather.radius = schedule.radius();
       gather.bandwidth_ps = schedule.bandwidth();
       gather.inv_emitted = 1.0 / static_cast<double>(pd.per_pass);
       gather.kernel = TemporalFilter(axis, TemporalFilter::Kind::Kernel, pd.kernel);
-      state.photon_radius_last = gather.radius;
-      state.photon_bandwidth_last_ps = gather.bandwidth_ps;
+      state.photon_radius_last = use_photons ? gather.radius : beam_gather.radius;
+      state.photon_bandwidth_last_ps = use_photons ? gather.bandwidth_ps : beam_gather.bandwidth_ps;
       // One camera sample per pixel, the same stream as sample `pass` of a path-only render.
       tbb::parallel_for(
           tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
@@ -108,11 +123,9 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                   double dx, dy;
                   pixel_offset(opt.seed, p, static_cast<uint64_t>(pass), dx, dy);
                   const double fx = x + dx, fy = y + dy;
-                  if (use_beams)
-                    integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, nullptr,
-                                     &beam_gather);
-                  else
-                    integrator.trace(camera.generate_ray(fx, fy), rng, acc, st, &gather);
+                  integrator.trace(camera.generate_ray(fx, fy), rng, acc, st,
+                                   use_photons ? &gather : nullptr,
+                                   use_beams ? &beam_gather : nullptr);
                   double* dst = state.sums.data() + p * stride;
                   for (size_t i = 0; i < nb; ++i) dst[i] += acc.bins[i];
                   passes::store_rgb(dst + nb, passes::load_rgb(dst + nb) + acc.before);
@@ -121,6 +134,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
             }
           });
       schedule.advance();
+      beam_schedule.advance();
       progress.add(1);
       ++state.units_done;
       state.stats += photon_stats;
@@ -139,6 +153,16 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   rep.radius_first = R1;
   rep.bandwidth_first_ps = T1;
   rep.radius_last = state.photon_radius_last;
+  if (caustic_beams) {
+    rep.hybrid_beams = true;
+    rep.beam_radius_first = bd.radius;
+    rep.beam_bandwidth_first_ps = bd.bandwidth_ps;
+    rep.beam_radius_last = beam_schedule.radius();
+    rep.beam_bandwidth_last_ps = beam_schedule.bandwidth();
+    rep.beam_alpha = bd.alpha;
+    rep.beam_beta_t = bd.beta_t;
+    rep.beam_paths = bd.per_pass;
+  }
   rep.bandwidth_last_ps = state.photon_bandwidth_last_ps;
   rep.max_stored_per_pass = state.photon_max_stored;
   rep.peak_photon_bytes = state.photon_peak_bytes;

@@ -137,11 +137,13 @@ struct LightDesc {
 
 /// Which estimators render the image (docs/outputs.md, "Integrators").
 enum class IntegratorKind {
-  Auto,     ///< path + photons when the scene has delta lights and non-diffuse surfaces, else path
+  Auto,     ///< hybrid (or photons without scattering media) when the scene has delta lights and
+            ///< non-diffuse surfaces, else path
   Path,     ///< camera paths only (volumetric path tracing)
   Light,    ///< light paths connected to the camera (light tracing)
   Photons,  ///< camera paths + transient progressive photon mapping for caustics on diffuse surfaces
-  Beams     ///< camera paths + transient progressive photon beams for all light scattered in media
+  Beams,    ///< camera paths + transient progressive photon beams for all light scattered in media
+  Hybrid    ///< camera paths + photons on surfaces + beams in media, each for caustic paths only
 };
 
 /// Progressive density estimation: photons on surfaces or photon beams in media (one pass =

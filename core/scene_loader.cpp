@@ -1059,11 +1059,12 @@ class Loader {
     check_keys(o, p, {"spp", "max_depth", "seed", "integrator", "light_paths", "photons"});
     if (const Json* s = find(o, "spp")) d.spp = int_in(*s, at(p, "spp"), 1, 10000000);
     if (const Json* s = find(o, "integrator")) {
-      const std::string k = choice(*s, at(p, "integrator"), {"auto", "path", "light", "photons", "beams"});
+      const std::string k = choice(*s, at(p, "integrator"), {"auto", "path", "light", "photons", "beams", "hybrid"});
       d.kind = k == "path"      ? IntegratorKind::Path
                : k == "light"   ? IntegratorKind::Light
                : k == "photons" ? IntegratorKind::Photons
                : k == "beams"   ? IntegratorKind::Beams
+               : k == "hybrid"  ? IntegratorKind::Hybrid
                                 : IntegratorKind::Auto;
     }
     if (const Json* s = find(o, "light_paths"))

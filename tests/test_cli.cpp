@@ -570,7 +570,8 @@ TEST_CASE("cli: unknown subcommand exits 2", "[cli]") {
 }
 
 // Catches: --integrator ignored, render.json not saying which integrator ran and why, the
-// automatic choice not picking photons for a delta light behind glass, or photon settings lost.
+// automatic choice not picking photons and beams (hybrid) for a delta light behind glass in fog,
+// or photon settings lost.
 TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
   CliTempDir tmp;
   json s = small_scene();
@@ -582,11 +583,12 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     std::string type, why_part;
   };
   const std::vector<Case> cases = {
-      {{}, "photons", "auto"},
+      {{}, "hybrid", "auto"},
       {{"--integrator", "path"}, "path", "chosen"},
       {{"--integrator", "light", "--light-paths", "20000"}, "light", "chosen"},
       {{"--integrator", "photons", "--photons", "3000", "--photon-radius", "2", "--photon-bandwidth", "20"},
        "photons", "chosen"},
+      {{"--integrator", "beams", "--photons", "500"}, "beams", "chosen"},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
     const fs::path out = tmp.dir / ("out" + std::to_string(i));
@@ -600,7 +602,7 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     const json& integ = info["settings"]["integrator"];
     CHECK(integ["type"] == cases[i].type);
     CHECK(contains(integ["why"].get<std::string>(), cases[i].why_part));
-    if (cases[i].type == "photons") {
+    if (cases[i].type == "photons" || cases[i].type == "hybrid") {
       CHECK(integ["passes"] == 2);
       CHECK(integ["photons_per_pass"].get<int64_t>() == (cases[i].flags.empty() ? 200000 : 3000));
       CHECK(integ["photon_memory_bytes_peak"].get<uint64_t>() > 0);
@@ -615,6 +617,12 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
       CHECK(info["counters"]["light_paths"].get<uint64_t>() > 0);
     }
     if (cases[i].type == "light") CHECK(integ["light_paths"] == 20000);
+    if (cases[i].type == "hybrid") CHECK(integ["caustic_beams"]["alpha"].get<double>() == Approx(2.0 / 3.0));
+    if (cases[i].type == "beams") {
+      CHECK(integ["photons_per_pass"] == 500);
+      CHECK(integ["alpha"].get<double>() == Approx(2.0 / 3.0));
+      CHECK(info["counters"]["beams_stored"].get<uint64_t>() > 0);
+    }
   }
 }
 
@@ -646,6 +654,9 @@ TEST_CASE("cli: bad integrator input exits 2 naming the key and value", "[cli]")
       {{"render", good, "--integrator", "path", "--photons", "1000"}, {"--photons", "photon mapping and photon beams only"}},
       {{"render", good, "--light-paths", "1000", "--integrator", "path"}, {"--light-paths"}},
       {{"render", good, "--integrator", "light", "--reconstruction", "kernel"}, {"light", "kernel film"}},
+      {{"render", with("nofog.json", [](json& t) { t.erase("media"); t.erase("medium"); }), "--integrator",
+        "beams"},
+       {"beams", "no scattering medium"}},
       {{"render", with("k1.json", [](json& t) { t["render"]["integrator"] = "photon"; })},
        {"/render/integrator", "photon"}},
       {{"render", with("k2.json", [](json& t) { t["render"]["photons"] = json{{"per_pass", -1}}; })},

@@ -18,6 +18,8 @@ const char* integrator_name(IntegratorKind kind) {
       return "photons";
     case IntegratorKind::Beams:
       return "beams";
+    case IntegratorKind::Hybrid:
+      return "hybrid";
   }
   return "?";
 }
@@ -43,8 +45,18 @@ IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, s
     why = "auto: the scene has caustics, but the kernel film works with camera paths only";
     return IntegratorKind::Path;
   }
-  why = "auto: delta lights and non-diffuse surfaces, so caustics come from photons";
-  return IntegratorKind::Photons;
+  const bool scattering = std::any_of(
+      scene.media.begin(), scene.media.end(),
+      [](const MediumDesc& m) { return m.type == MediumDesc::Type::Vdb || m.medium.sigma_s > 0; });
+  if (!scattering) {
+    why = "auto: delta lights and non-diffuse surfaces, so caustics come from photons";
+    return IntegratorKind::Photons;
+  }
+  why =
+      "auto: delta lights, non-diffuse surfaces and a scattering medium, so caustics come from "
+      "photons on "
+      "surfaces and photon beams in media";
+  return IntegratorKind::Hybrid;
 }
 
 PhotonDesc progressive_settings(const Scene& scene, IntegratorKind kind, PhotonDesc p) {

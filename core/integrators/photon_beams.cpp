@@ -146,7 +146,7 @@ void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, do
 }
 
 std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64_t count,
-                              int max_depth, double t_cut_ps, PathStats& stats) {
+                              int max_depth, double t_cut_ps, PathStats& stats, bool caustic_only) {
   const MediumTracker tracker(scene);
   const int64_t chunks = (count + kChunk - 1) / kChunk;
   std::vector<std::vector<Beam>> per_chunk(static_cast<size_t>(chunks));
@@ -163,7 +163,10 @@ std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64
             walk_light_path(
                 scene, tracker, rng, max_depth, t_cut_ps, st,
                 [&](const LightVertex& v) {
+                  // A caustic path is over once it scatters off a diffuse surface or in a medium.
+                  if (caustic_only && v.chain < 0) return false;
                   if (v.kind != LightVertex::Kind::Segment) return true;
+                  if (caustic_only && v.chain < 1) return true;
                   // Beyond the window's end nothing it lights can be seen (eta >= 1: time >=
                   // distance / c).
                   const double reach = (t_cut_ps - v.t_ps) * kSpeedOfLight;

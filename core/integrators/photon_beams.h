@@ -62,6 +62,11 @@ struct BeamGather {
   double bandwidth_ps = 0;  ///< T_j, ps
   double inv_paths = 1;     ///< 1 / light paths traced in the pass
   TemporalFilter kernel;
+  /// Caustic beams only (the hybrid integrator): the beams are light paths' segments after one or
+  /// more non-diffuse surfaces and nothing else; camera paths gather them along every medium
+  /// segment and leave those paths out of their own estimate. Otherwise (all beams) camera paths
+  /// gather them only before their first non-specular surface, and do not scatter in media there.
+  bool caustic_only = false;
   /// Adds the in-scattered radiance from beams along [0, s_max) of `ray` in medium m, seen with
   /// throughput beta from camera time t (t_factor converts OPL to time on this segment: 0 on an
   /// unwarped camera segment).
@@ -70,9 +75,11 @@ struct BeamGather {
 };
 
 /// Traces `count` light paths of one pass and returns their beams in path order (the same list
-/// for any thread count).
+/// for any thread count). `caustic_only`: only segments that follow one or more non-diffuse
+/// surfaces with no medium or diffuse scattering before them (light -> (S|G)+ -> medium).
 std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64_t count,
-                              int max_depth, double t_cut_ps, PathStats& stats);
+                              int max_depth, double t_cut_ps, PathStats& stats,
+                              bool caustic_only = false);
 
 /// Memory of one pass holding `beams` beams: the traced lists and the tree's copy, the build's
 /// boxes and centres, and the nodes (at most one per beam).

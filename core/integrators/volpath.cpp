@@ -119,19 +119,28 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   int depth = 0;
   int null_crossings = 0;
   double u_next = -1.0;  // pre-drawn distance uniform for the next segment (angular sampling)
-  // Path-space partition with photons (docs/ARCHITECTURE.md): light reaching a diffuse vertex
-  // through one or more non-diffuse surfaces belongs to the photons. 0: no diffuse vertex yet or
-  // a medium event since; 1: just left a diffuse vertex; 2: non-diffuse surfaces since it.
-  int caustic_chain = 0;
-  // Photon beams own the paths whose first non-specular vertex from the camera is in a medium.
-  bool beam_prefix = beams != nullptr;
+  // Path-space partition (docs/ARCHITECTURE.md): light that reaches a diffuse vertex through one
+  // or more non-diffuse surfaces belongs to the photons, and light that reaches a medium point
+  // that way to the caustic beams. `last` is the latest non-specular vertex (diffuse surface or
+  // medium) and `since` counts the non-diffuse surfaces met after it.
+  enum class Last { Camera, Diffuse, Medium } last = Last::Camera;
+  int since = 0;
+  const bool caustic_beams = beams && beams->caustic_only;
+  auto owned = [&](Last l) {
+    return (l == Last::Diffuse && photons) || (l == Last::Medium && caustic_beams);
+  };
+  // All beams: they own the paths whose first non-specular vertex from the camera is in a medium.
+  bool beam_prefix = beams != nullptr && !caustic_beams;
 
   for (;;) {
     SurfaceHit hit;
     const bool found = scene_.geometry().intersect(ray, 0.0, kInf, hit);
     const double s_surf = found ? hit.s : kInf;
     const Medium& med = media[static_cast<size_t>(m)];
-    if (beams && beam_prefix && med.interacts()) {
+    if (caustic_beams && med.interacts() && depth < max_depth_)
+      beams->gather(m, ray, s_surf, beta, t,
+                    unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
+    if (beam_prefix && med.interacts()) {
       // Before the first non-specular surface, light scattered in a medium comes from the beams:
       // the camera path passes through with the segment's exact transmittance.
       const double t_seg = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
@@ -176,7 +185,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       if (ev.collided) {
         // Real collision: absorb by weighting with the single-scattering albedo.
         on_camera_segment = false;
-        caustic_chain = 0;
+        last = Last::Medium;
+        since = 0;
         ++stats.medium_events;
         if (depth >= max_depth_) {
           ++stats.max_depth_hits;
@@ -202,7 +212,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     // Surface interaction.
     const ShapeDesc& sh = shapes[static_cast<size_t>(hit.shape)];
     const bool front = dot(ray.d, hit.ng) < 0;
-    if (sh.emissive && front && !(photons && caustic_chain == 2)) {
+    if (sh.emissive && front && !(since > 0 && owned(last))) {
       const int li = lights.light_of_shape(hit.shape);
       double w = 1.0;
       if (!specular) {
@@ -233,9 +243,14 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     const bool wo_outside = front;
     if (photons && bsdf.is_diffuse()) photons->gather(bsdf, hit, frame, wo, beta, t, acc, stats);
     // Next-event estimation, except where a photon owns the path (light -> glossy -> diffuse).
-    if (!bsdf.is_delta() && !(photons && !bsdf.is_diffuse() && caustic_chain > 0))
+    if (!bsdf.is_delta() && !(!bsdf.is_diffuse() && owned(last)))
       estimate_direct_surface(bsdf, hit, frame, wo, wo_outside, beta, t, rng, acc, stats);
-    if (photons) caustic_chain = bsdf.is_diffuse() ? 1 : (caustic_chain > 0 ? 2 : 0);
+    if (bsdf.is_diffuse()) {
+      last = Last::Diffuse;
+      since = 0;
+    } else if (last != Last::Camera) {
+      ++since;
+    }
     if (!bsdf.is_delta()) beam_prefix = false;
 
     BsdfSample bs;
