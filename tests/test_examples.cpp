@@ -1,5 +1,5 @@
-// Every example scene in data/scenes loads, builds and renders (tiny resolution, 2 spp) to a
-// finite, non-black film.
+// Every example scene in data/scenes loads, builds and renders (tiny resolution, 2 spp, with the
+// integrator femto render would choose) to a finite, non-black film.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -20,8 +20,13 @@ TEST_CASE("example scenes load and render", "[examples]") {
     SceneDesc desc = load_scene_file(entry.path().string());
     desc.camera.width = 24;
     desc.camera.height = 18;
-    const Scene scene(std::move(desc));
+    std::string why;
     RenderOptions opt;
+    opt.integrator = resolve_integrator(desc, desc.integrator.kind, why);  // as femto render would
+    opt.photons = desc.integrator.photons;
+    opt.photons.per_pass = 2000;
+    opt.light_paths = 20000;
+    const Scene scene(std::move(desc));
     opt.spp = 2;
     opt.quiet = true;
     const RenderResult r = render(scene, opt);
