@@ -170,9 +170,17 @@ int main(int argc, char** argv) {
       o.threads = std::atoi(next().c_str());
     else if (a == "--seed")
       o.seed = std::strtoull(next().c_str(), nullptr, 10);
+    else if (a == "--crop") {
+      if (std::sscanf(next().c_str(), "%d,%d,%d,%d", &o.x0, &o.y0, &o.x1, &o.y1) != 4) {
+        std::fprintf(stderr, "femto-bench-caustics: --crop expects X0,Y0,X1,Y1\n");
+        return 2;
+      }
+    }
     else if (a == "--help") {
       std::printf(
-          "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S]\n");
+          "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S] "
+          "[--crop X0,Y0,X1,Y1]\n  default crop: the caustic on the floor; --crop 100,88,156,128: the fog "
+          "under the sphere\n");
       return 0;
     } else {
       std::fprintf(stderr, "femto-bench-caustics: unknown option %s\n", a.c_str());
@@ -221,7 +229,8 @@ int main(int argc, char** argv) {
   const Case cases[] = {
       {"path (sphere emitter r = 2 mm)", &sphere, IntegratorKind::Path, &ref_sphere},
       {"light tracing", &spot, IntegratorKind::Light, &ref_spot},
-      {"path + photons", &spot, IntegratorKind::Photons, &ref_spot}};
+      {"path + photons", &spot, IntegratorKind::Photons, &ref_spot},
+      {"hybrid (photons + caustic beams)", &spot, IntegratorKind::Hybrid, &ref_spot}};
   std::printf("\n%-32s %14s %9s %13s %16s %22s\n", "estimator", "work", "seconds", "steady rRMSE",
               "transient rRMSE", "equal-time transient");
   double base_steady = 0, base_transient = 0;
@@ -243,7 +252,7 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   std::printf(
-      "\nwork: spp (path), passes of 1 spp + photons (path + photons), light paths (light "
-      "tracing)\n");
+      "\nwork: spp (path), passes of 1 spp + photons (+ beams) (path + photons, hybrid), light "
+      "paths (light tracing)\n");
   return 0;
 }
