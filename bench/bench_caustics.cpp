@@ -198,7 +198,7 @@ int main(int argc, char** argv) {
   const Scene spot(spot_desc);
   const Scene sphere(sphere_emitter_scene(spot_desc, 2.0));
   const std::vector<int> px = crop_pixels(spot, o, *glass);
-  std::printf("crop x [%d, %d) y [%d, %d): %zu floor pixels that see no glass\n", o.x0, o.x1, o.y0,
+  std::printf("crop x [%d, %d) y [%d, %d): %zu pixels that see no glass\n", o.x0, o.x1, o.y0,
               o.y1, px.size());
 
   std::printf("references (light tracing, two halves each)...\n");

@@ -175,7 +175,7 @@ SceneDesc caustic_scene(const TimeAxis& axis) {
 // in the camera connection, medium time taken from distance instead of OPL, or time added in the
 // wrong place: light tracing and camera paths estimate the same bins only if all are right.
 TEST_CASE("light tracing agrees with camera paths: fog with a point light and diffuse walls",
-          "[light-paths]") {
+          "[light-paths][statistical]") {
   // The fog fills a box (kept clear of the walls: coincident faces are ambiguous) that leaves out
   // the camera: a camera inside a medium gives light tracing infinite variance (1 / d^2 connections
   // from vertices next to the sensor), as a point light does for collision next-event estimation
@@ -206,7 +206,7 @@ TEST_CASE("light tracing agrees with camera paths: fog with a point light and di
 // one-sided emission of area lights handled differently on the two sides.
 TEST_CASE(
     "light tracing agrees with camera paths: a diffuse room with an area light and a point light",
-    "[light-paths]") {
+    "[light-paths][statistical]") {
   SceneDesc d;
   d.source = "room";
   d.camera = perspective({0, 40, 150}, {0, 35, 0}, 50, 16, 12);
@@ -231,7 +231,7 @@ TEST_CASE(
 // importance-mode BSDF (no 1/eta^2 on refraction), rough refraction seen by the camera through
 // connections from the exit vertex, and the two-sided rough conductor.
 TEST_CASE("light tracing agrees with camera paths through rough glass and off rough metal",
-          "[light-paths]") {
+          "[light-paths][statistical]") {
   SceneDesc d;
   d.source = "rough";
   d.camera = perspective({0, 30, 120}, {0, 20, 0}, 45, 16, 12);
@@ -261,7 +261,7 @@ TEST_CASE("light tracing agrees with camera paths through rough glass and off ro
 // Catches: emission sampling of spot lights (cone, falloff) and lasers (beam radius, flux), and
 // pulses (Gaussian width, offset) on the light side: both lights with pulses, in fog over a floor.
 TEST_CASE("light tracing agrees with camera paths for a spot light and a laser with pulses",
-          "[light-paths]") {
+          "[light-paths][statistical]") {
   const SceneDesc d = load_scene_string(R"({
     "camera": { "type": "perspective", "position": [0, 40, 130], "look_at": [0, 15, 0], "fov": 45,
                 "resolution": [16, 12] },
@@ -290,7 +290,7 @@ TEST_CASE("light tracing agrees with camera paths for a spot light and a laser w
 // Catches: light paths that do not follow the per-voxel index (time from the wrong eta, or the
 // voxel medium's albedo and extinction ignored on the light side).
 TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-voxel eta",
-          "[light-paths]") {
+          "[light-paths][statistical]") {
   TempDir tmp("femto_light_paths");
   const int n = 12;
   DenseGrid density(n, n, n, 0.0f), eta(n, n, n, 1.0f);
@@ -332,7 +332,7 @@ TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-vox
 // dropping or double-counting paths (camera paths cannot reach light -> glass -> floor from a
 // point light at all, so both estimators here see caustics through different techniques).
 TEST_CASE("camera paths + photons agree with light tracing on a caustic from a point light",
-          "[light-paths]") {
+          "[light-paths][statistical]") {
   const Scene scene(caustic_scene(axis_of(250, 60, 8)));
   PhotonDesc pd;
   pd.per_pass = 40000;
@@ -347,7 +347,7 @@ TEST_CASE("camera paths + photons agree with light tracing on a caustic from a p
 // (double counting), or dropping other paths: an emissive sphere behind glass is reachable by
 // camera paths alone, so path-only and path + photons must agree.
 TEST_CASE("path-only and path + photons agree for an emissive sphere behind glass",
-          "[light-paths]") {
+          "[light-paths][statistical]") {
   SceneDesc d;
   d.source = "partition";
   d.camera = perspective({0, 60, 90}, {0, 0, 0}, 50, 16, 12);
@@ -396,7 +396,7 @@ TEST_CASE("progressive radius and bandwidth follow the schedule", "[light-paths]
 // Catches: photon-mapping bias that does not go away: at a caustic's sharp edge the disc kernel
 // blurs light out of the caustic; with the progressive schedule the radius shrinks and the
 // estimate of the edge region must move towards the unbiased light-tracing answer.
-TEST_CASE("the photon estimate's bias shrinks as passes go on", "[light-paths]") {
+TEST_CASE("the photon estimate's bias shrinks as passes go on", "[light-paths][statistical]") {
   const Scene scene(caustic_scene(axis_of(0, 2000, 1)));
   const int W = 12;
   auto pixel = [&](const TransientFilm& f, int x, int y) {

@@ -89,7 +89,7 @@ std::vector<std::vector<double>> cells(const std::vector<TransientFilm>& films, 
 // (OPL along the beam and the camera ray), or paths counted twice or lost between beams and
 // camera paths: all light scattered in the fog comes from beams here, and must match camera paths
 // cell by cell within 4 combined standard errors.
-TEST_CASE("photon beams agree with camera paths in a fog box, bin by bin", "[beams]") {
+TEST_CASE("photon beams agree with camera paths in a fog box, bin by bin", "[beams][statistical]") {
   const Scene scene(fog_box(16, 12));
   PhotonDesc pd;
   pd.per_pass = 4000;
@@ -140,7 +140,7 @@ TEST_CASE("beam radius and bandwidth follow the 1-D schedule", "[beams]") {
 // Catches: beam-kernel bias that stays: near the point light the fluence falls off fast, so a
 // wide fixed beam radius blurs light away from the beams' cores; shrinking radii must move the
 // estimate of the brightest region towards the camera-path answer.
-TEST_CASE("the beam estimate's bias shrinks as passes go on", "[beams]") {
+TEST_CASE("the beam estimate's bias shrinks as passes go on", "[beams][statistical]") {
   SceneDesc d = fog_box(16, 12);
   d.time.t_start_ps = 0;
   d.time.bin_width_ps = 3000;
@@ -204,7 +204,8 @@ TEST_CASE("photon beams are bit-identical for 1 and 2 threads", "[beams]") {
 
 // Catches: beam times that ignore the per-voxel index (OPL along the beam and along the camera
 // ray) or sigma_s read at the wrong place in a heterogeneous medium.
-TEST_CASE("photon beams agree with camera paths in a voxel medium with per-voxel eta", "[beams]") {
+TEST_CASE("photon beams agree with camera paths in a voxel medium with per-voxel eta",
+          "[beams][statistical]") {
   TempDir tmp("femto_beams");
   const int n = 12;
   DenseGrid density(n, n, n, 0.0f), eta(n, n, n, 1.0f);
@@ -325,7 +326,8 @@ SceneDesc glass_in_fog(const std::string& lights, const std::string& extra_shape
 // Catches: caustic beams or photons double-counting light that camera paths also find, or camera
 // paths dropping paths that no estimator owns: an emissive sphere behind glass in fog is
 // reachable by camera paths alone, so path-only and hybrid must agree.
-TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog", "[beams]") {
+TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog",
+          "[beams][statistical]") {
   const SceneDesc d = glass_in_fog("", R"(,
       { "type": "sphere", "center": [-15, 70, 0], "radius": 5, "emission": 30,
         "material": { "type": "diffuse", "albedo": 0 } })");
@@ -343,7 +345,7 @@ TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog"
 // light -> glass -> fog from a point light; light tracing splats every fog and floor vertex to
 // the camera, which sees them directly).
 TEST_CASE("hybrid agrees with light tracing on a volumetric caustic from a point light",
-          "[beams]") {
+          "[beams][statistical]") {
   const SceneDesc d =
       glass_in_fog(R"({ "type": "point", "position": [-30, 80, 0], "intensity": 3000 })", "");
   const Scene scene(d);
