@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "agreement.h"
 #include "core/constants.h"
 #include "core/integrators/ppm_schedule.h"
 #include "core/scene_loader.h"
@@ -53,97 +54,6 @@ LightDesc point_light(const Vec3& p, double intensity) {
   l.position = p;
   l.intensity = RGB(intensity);
   return l;
-}
-
-/// One film per seed with the given integrator; `work` is spp (path, photons) or light paths.
-std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kind, int64_t work, int n,
-                                   uint64_t seed0, const PhotonDesc& photons = {}) {
-  std::vector<TransientFilm> films;
-  for (int b = 0; b < n; ++b) {
-    RenderOptions opt;
-    opt.integrator = kind;
-    opt.spp = kind == IntegratorKind::Light ? 1 : static_cast<int>(work);
-    opt.light_paths = kind == IntegratorKind::Light ? work : 0;
-    opt.photons = photons;
-    opt.seed = seed0 + static_cast<uint64_t>(b);
-    opt.threads = 2;
-    opt.quiet = true;
-    films.push_back(render(scene, opt).film);
-  }
-  return films;
-}
-
-/// Per-batch sums of the three channels over blocks of `block` x `block` pixels and groups of
-/// `group` bins: cells[c][b] for cell c of batch b.
-std::vector<std::vector<double>> cells(const std::vector<TransientFilm>& films, int block,
-                                       int group) {
-  const TransientFilm& f0 = films.front();
-  const int bx = (f0.width() + block - 1) / block, by = (f0.height() + block - 1) / block;
-  const int bt = (f0.bins() + group - 1) / group;
-  std::vector<std::vector<double>> out(static_cast<size_t>(bx * by * bt),
-                                       std::vector<double>(films.size(), 0.0));
-  for (size_t b = 0; b < films.size(); ++b) {
-    const float* v = films[b].transient();
-    for (int y = 0; y < f0.height(); ++y)
-      for (int x = 0; x < f0.width(); ++x)
-        for (int t = 0; t < f0.bins(); ++t) {
-          const size_t i =
-              ((static_cast<size_t>(y) * static_cast<size_t>(f0.width()) + static_cast<size_t>(x)) *
-                   static_cast<size_t>(f0.bins()) +
-               static_cast<size_t>(t)) *
-              3;
-          const size_t c = static_cast<size_t>(((y / block) * bx + x / block) * bt + t / group);
-          out[c][b] += static_cast<double>(v[i]) + v[i + 1] + v[i + 2];
-        }
-  }
-  return out;
-}
-
-struct Agreement {
-  int compared = 0;
-  double max_z = 0;
-  double chi2 = 0;
-  double rel_se_total = 0;  ///< combined standard error of the summed signal, relative to it
-  double rel_se_a = 0, rel_se_b = 0;  ///< each estimator's share
-};
-
-/// Compares two estimators cell by cell: z = difference / combined standard error, over cells
-/// whose signal is at least `min_share` of the largest cell's.
-Agreement compare(const std::vector<std::vector<double>>& a,
-                  const std::vector<std::vector<double>>& b, double min_share = 0.02) {
-  Agreement g;
-  double peak = 0;
-  for (const auto& c : a) peak = std::max(peak, mean_se(c).mean);
-  double total = 0, var_a = 0, var_b = 0;
-  for (size_t c = 0; c < a.size(); ++c) {
-    const MeanSE x = mean_se(a[c]), y = mean_se(b[c]);
-    total += x.mean;
-    var_a += x.se * x.se;
-    var_b += y.se * y.se;
-    if (std::max(x.mean, y.mean) < min_share * peak) continue;
-    const double se = std::sqrt(x.se * x.se + y.se * y.se);
-    if (!(se > 0)) continue;
-    const double z = (x.mean - y.mean) / se;
-    g.max_z = std::max(g.max_z, std::abs(z));
-    g.chi2 += z * z;
-    ++g.compared;
-  }
-  g.rel_se_total = std::sqrt(var_a + var_b) / total;
-  g.rel_se_a = std::sqrt(var_a) / total;
-  g.rel_se_b = std::sqrt(var_b) / total;
-  return g;
-}
-
-void require_agreement(const Agreement& g, int min_cells) {
-  INFO("cells " << g.compared << ", max |z| " << g.max_z << ", chi2 " << g.chi2
-                << ", relative SE of the total " << g.rel_se_total << " (" << g.rel_se_a << " and "
-                << g.rel_se_b << ")");
-  REQUIRE(g.compared >= min_cells);
-  CHECK(g.max_z < 4.0);
-  // Sum of z^2 over the cells: catches a small bias shared by many cells that no single cell shows.
-  CHECK(stats::chi2_survival(g.chi2, g.compared) > 1e-3);
-  // Resolution: an 8% error in the total would be more than 4 combined standard errors.
-  CHECK(g.rel_se_total < 0.02);
 }
 
 /// A point light beside and above a glass sphere over a diffuse floor; the orthographic camera
@@ -199,7 +109,7 @@ TEST_CASE("light tracing agrees with camera paths: fog with a point light and di
   const Scene scene(d);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 128, 24, 100), 4, 3);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 100000, 24, 200), 4, 3);
-  require_agreement(compare(pt, lt), 15);
+  require_agreement(pt, lt, 15);
 }
 
 // Catches: the emitter vertex (an area light seen directly), cosines at diffuse vertices, or the
@@ -224,7 +134,7 @@ TEST_CASE(
   const Scene scene(d);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 64, 24, 300), 4, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 50000, 24, 400), 4, 2);
-  require_agreement(compare(pt, lt), 20);
+  require_agreement(pt, lt, 20);
 }
 
 // Catches: light paths and camera paths scattering off rough surfaces differently: the
@@ -255,7 +165,7 @@ TEST_CASE("light tracing agrees with camera paths through rough glass and off ro
   const Scene scene(d);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 128, 24, 1400), 4, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 80000, 24, 1500), 4, 2);
-  require_agreement(compare(pt, lt), 15);
+  require_agreement(pt, lt, 15);
 }
 
 // Catches: emission sampling of spot lights (cone, falloff) and lasers (beam radius, flux), and
@@ -284,7 +194,7 @@ TEST_CASE("light tracing agrees with camera paths for a spot light and a laser w
   const Scene scene(d);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 320, 24, 1600), 4, 3);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 60000, 24, 1700), 4, 3);
-  require_agreement(compare(pt, lt), 15);
+  require_agreement(pt, lt, 15);
 }
 
 // Catches: light paths that do not follow the per-voxel index (time from the wrong eta, or the
@@ -292,32 +202,11 @@ TEST_CASE("light tracing agrees with camera paths for a spot light and a laser w
 TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-voxel eta",
           "[light-paths][statistical]") {
   TempDir tmp("femto_light_paths");
-  const int n = 12;
-  DenseGrid density(n, n, n, 0.0f), eta(n, n, n, 1.0f);
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x) {
-        const size_t i =
-            (static_cast<size_t>(z) * n + static_cast<size_t>(y)) * n + static_cast<size_t>(x);
-        density.v[i] = 0.01f + 0.004f * static_cast<float>(x + y);
-        eta.v[i] = 1.0f + 0.05f * static_cast<float>(z);
-      }
-  density.update_range();
-  eta.update_range();
-  const std::string file = (tmp.dir / "eta.vdb").string();
-  write_volume(file, density, nullptr, &eta, 5.0, {-30, 0, -30});
+  const MediumDesc m = graded_voxel_medium(tmp.dir);
   SceneDesc d;
   d.source = "voxels";
   d.camera = perspective({0, 30, 130}, {0, 25, 0}, 50, 16, 12);
   d.time = axis_of(300, 100, 10);
-  MediumDesc m;
-  m.name = "vdb";
-  m.type = MediumDesc::Type::Vdb;
-  m.vdb.file = file;
-  m.vdb.albedo = 0.85;
-  m.vdb.eta = 1.0;
-  m.vdb.eta_grid = "eta";
-  m.medium.g = 0.2;
   d.media.push_back(m);
   d.global_medium = 0;
   d.shapes.push_back(quad({-60, 0, 60}, {120, 0, 0}, {0, 0, -120}, diffuse(0.6)));
@@ -325,7 +214,7 @@ TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-vox
   const Scene scene(d);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 64, 24, 500), 4, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 50000, 24, 600), 4, 2);
-  require_agreement(compare(pt, lt), 15);
+  require_agreement(pt, lt, 15);
 }
 
 // Catches: photons stored or gathered with the wrong normalisation or time, the caustic partition
@@ -340,7 +229,7 @@ TEST_CASE("camera paths + photons agree with light tracing on a caustic from a p
   pd.bandwidth_ps = 1.0;
   const auto ph = cells(batches(scene, IntegratorKind::Photons, 16, 24, 700, pd), 3, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 40000, 24, 800), 3, 2);
-  require_agreement(compare(ph, lt), 10);
+  require_agreement(ph, lt, 10);
 }
 
 // Catches: camera paths still counting light -> glass -> floor -> camera when photons are on
@@ -367,7 +256,7 @@ TEST_CASE("path-only and path + photons agree for an emissive sphere behind glas
   pd.bandwidth_ps = 1.0;
   const auto pt = cells(batches(scene, IntegratorKind::Path, 64, 24, 900), 4, 2);
   const auto ph = cells(batches(scene, IntegratorKind::Photons, 64, 24, 1000, pd), 4, 2);
-  require_agreement(compare(pt, ph), 15);
+  require_agreement(pt, ph, 15);
 }
 
 // Catches: a schedule that does not shrink, or shrinks the wrong power: R^2 T must fall by

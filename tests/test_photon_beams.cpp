@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "agreement.h"
 #include "core/integrators/photon_beams.h"
 #include "core/integrators/ppm_schedule.h"
 #include "core/scene_loader.h"
@@ -42,46 +43,6 @@ SceneDesc fog_box(int w, int h) {
   return d;
 }
 
-std::vector<TransientFilm> runs(const Scene& scene, IntegratorKind kind, int spp, int n,
-                                uint64_t seed0, const PhotonDesc& pd = {}) {
-  std::vector<TransientFilm> films;
-  for (int b = 0; b < n; ++b) {
-    RenderOptions opt;
-    opt.integrator = kind;
-    opt.spp = spp;
-    opt.photons = pd;
-    opt.seed = seed0 + static_cast<uint64_t>(b);
-    opt.threads = 2;
-    opt.quiet = true;
-    films.push_back(render(scene, opt).film);
-  }
-  return films;
-}
-
-/// Per-batch sums over blocks of pixels and groups of bins (all channels): cells[c][batch].
-std::vector<std::vector<double>> cells(const std::vector<TransientFilm>& films, int block,
-                                       int group) {
-  const TransientFilm& f0 = films.front();
-  const int bx = (f0.width() + block - 1) / block, by = (f0.height() + block - 1) / block;
-  const int bt = (f0.bins() + group - 1) / group;
-  std::vector<std::vector<double>> out(static_cast<size_t>(bx * by * bt),
-                                       std::vector<double>(films.size(), 0.0));
-  for (size_t b = 0; b < films.size(); ++b)
-    for (int y = 0; y < f0.height(); ++y)
-      for (int x = 0; x < f0.width(); ++x)
-        for (int t = 0; t < f0.bins(); ++t) {
-          const size_t i =
-              ((static_cast<size_t>(y) * static_cast<size_t>(f0.width()) + static_cast<size_t>(x)) *
-                   static_cast<size_t>(f0.bins()) +
-               static_cast<size_t>(t)) *
-              3;
-          const size_t c = static_cast<size_t>(((y / block) * bx + x / block) * bt + t / group);
-          const float* v = films[b].transient();
-          out[c][b] += static_cast<double>(v[i]) + v[i + 1] + v[i + 2];
-        }
-  return out;
-}
-
 }  // namespace
 
 // Catches: a wrong beam estimator (the 1 / sin(theta) factor, the 1-D kernel's 1 / (2R), the phase
@@ -96,30 +57,9 @@ TEST_CASE("photon beams agree with camera paths in a fog box, bin by bin", "[bea
   pd.radius =
       0.5;  // small against the 4 x 4 pixel blocks compared: kernel bias far below the noise
   pd.bandwidth_ps = 1.0;
-  const auto pt = cells(runs(scene, IntegratorKind::Path, 128, 24, 100), 4, 3);
-  const auto bm = cells(runs(scene, IntegratorKind::Beams, 16, 24, 200, pd), 4, 3);
-  double peak = 0;
-  for (const auto& c : pt) peak = std::max(peak, mean_se(c).mean);
-  int compared = 0;
-  double chi2 = 0, max_z = 0, total = 0, var_pt = 0, var_bm = 0;
-  for (size_t c = 0; c < pt.size(); ++c) {
-    const MeanSE a = mean_se(pt[c]), b = mean_se(bm[c]);
-    total += a.mean;
-    var_pt += a.se * a.se;
-    var_bm += b.se * b.se;
-    if (std::max(a.mean, b.mean) < 0.02 * peak) continue;
-    const double z = (a.mean - b.mean) / std::sqrt(a.se * a.se + b.se * b.se);
-    chi2 += z * z;
-    max_z = std::max(max_z, std::abs(z));
-    ++compared;
-  }
-  INFO("cells " << compared << ", max |z| " << max_z << ", chi2 " << chi2
-                << ", relative SE of the total: path " << std::sqrt(var_pt) / total << ", beams "
-                << std::sqrt(var_bm) / total);
-  REQUIRE(compared >= 15);
-  CHECK(max_z < 4.0);
-  CHECK(stats::chi2_survival(chi2, compared) > 1e-3);
-  CHECK(std::sqrt(var_pt + var_bm) / total < 0.02);  // an 8% error would be 4 standard errors
+  const auto pt = cells(batches(scene, IntegratorKind::Path, 128, 24, 100), 4, 3);
+  const auto bm = cells(batches(scene, IntegratorKind::Beams, 16, 24, 200, pd), 4, 3);
+  require_agreement(pt, bm, 15);
 }
 
 // Catches: a schedule that does not shrink the beam radius (or shrinks R^2 instead of R): the
@@ -147,7 +87,7 @@ TEST_CASE("the beam estimate's bias shrinks as passes go on", "[beams][statistic
   d.time.bins = 1;
   const Scene scene(d);
   // The brightest 2 x 2 block of the camera-path answer (around the light).
-  const auto ref_films = runs(scene, IntegratorKind::Path, 512, 12, 300);
+  const auto ref_films = batches(scene, IntegratorKind::Path, 512, 12, 300);
   auto px = [&](const TransientFilm& f, int x, int y) {
     return f.steady()[3 * static_cast<size_t>(y * 16 + x) + 1];
   };
@@ -172,8 +112,9 @@ TEST_CASE("the beam estimate's bias shrinks as passes go on", "[beams][statistic
   fixed.alpha = 1.0;  // no shrinking
   PhotonDesc progressive = fixed;
   progressive.alpha = 0.2;  // fast shrinking, to resolve the change within a short test
-  for (const auto& f : runs(scene, IntegratorKind::Beams, 32, 8, 400, fixed)) a.push_back(block(f));
-  for (const auto& f : runs(scene, IntegratorKind::Beams, 32, 8, 500, progressive))
+  for (const auto& f : batches(scene, IntegratorKind::Beams, 32, 8, 400, fixed))
+    a.push_back(block(f));
+  for (const auto& f : batches(scene, IntegratorKind::Beams, 32, 8, 500, progressive))
     b.push_back(block(f));
   const MeanSE r = mean_se(ref), fa = mean_se(a), fb = mean_se(b);
   const double bias_fixed = fa.mean - r.mean, bias_prog = fb.mean - r.mean;
@@ -207,31 +148,10 @@ TEST_CASE("photon beams are bit-identical for 1 and 2 threads", "[beams]") {
 TEST_CASE("photon beams agree with camera paths in a voxel medium with per-voxel eta",
           "[beams][statistical]") {
   TempDir tmp("femto_beams");
-  const int n = 12;
-  DenseGrid density(n, n, n, 0.0f), eta(n, n, n, 1.0f);
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x) {
-        const size_t i =
-            (static_cast<size_t>(z) * n + static_cast<size_t>(y)) * n + static_cast<size_t>(x);
-        density.v[i] = 0.01f + 0.004f * static_cast<float>(x + y);
-        eta.v[i] = 1.0f + 0.05f * static_cast<float>(z);
-      }
-  density.update_range();
-  eta.update_range();
-  const std::string file = (tmp.dir / "eta.vdb").string();
-  write_volume(file, density, nullptr, &eta, 5.0, {-30, 0, -30});
+  const MediumDesc m = graded_voxel_medium(tmp.dir);
   SceneDesc d = fog_box(16, 12);
   d.shapes.erase(d.shapes.begin());  // no fog box: the voxel medium fills everything
   d.media.clear();
-  MediumDesc m;
-  m.name = "vdb";
-  m.type = MediumDesc::Type::Vdb;
-  m.vdb.file = file;
-  m.vdb.albedo = 0.85;
-  m.vdb.eta = 1.0;
-  m.vdb.eta_grid = "eta";
-  m.medium.g = 0.2;
   d.media.push_back(m);
   d.global_medium = 0;
   for (auto& s : d.shapes) s.interior_medium = -1;
@@ -245,61 +165,12 @@ TEST_CASE("photon beams agree with camera paths in a voxel medium with per-voxel
   pd.per_pass = 4000;
   pd.radius = 0.5;
   pd.bandwidth_ps = 1.0;
-  const auto pt = cells(runs(scene, IntegratorKind::Path, 96, 16, 600), 4, 2);
-  const auto bm = cells(runs(scene, IntegratorKind::Beams, 16, 16, 700, pd), 4, 2);
-  double peak = 0;
-  for (const auto& c : pt) peak = std::max(peak, mean_se(c).mean);
-  int compared = 0;
-  double chi2 = 0, max_z = 0, total = 0, var = 0;
-  for (size_t c = 0; c < pt.size(); ++c) {
-    const MeanSE a = mean_se(pt[c]), b = mean_se(bm[c]);
-    total += a.mean;
-    var += a.se * a.se + b.se * b.se;
-    if (std::max(a.mean, b.mean) < 0.02 * peak) continue;
-    const double z = (a.mean - b.mean) / std::sqrt(a.se * a.se + b.se * b.se);
-    chi2 += z * z;
-    max_z = std::max(max_z, std::abs(z));
-    ++compared;
-  }
-  INFO("cells " << compared << ", max |z| " << max_z << ", chi2 " << chi2
-                << ", relative SE of the total " << std::sqrt(var) / total);
-  REQUIRE(compared >= 10);
-  CHECK(max_z < 4.0);
-  CHECK(stats::chi2_survival(chi2, compared) > 1e-3);
-  CHECK(std::sqrt(var) / total < 0.02);
+  const auto pt = cells(batches(scene, IntegratorKind::Path, 96, 16, 600), 4, 2);
+  const auto bm = cells(batches(scene, IntegratorKind::Beams, 16, 16, 700, pd), 4, 2);
+  require_agreement(pt, bm, 10);
 }
 
 namespace {
-
-/// Per-cell agreement of two estimators within 4 combined standard errors, with a chi-square
-/// over the cells and a resolution requirement: an error of 4 x `resolution` in the total would
-/// be 4 combined standard errors.
-void require_agreement(const std::vector<std::vector<double>>& a,
-                       const std::vector<std::vector<double>>& b, int min_cells,
-                       double resolution = 0.02) {
-  double peak = 0;
-  for (const auto& c : a) peak = std::max(peak, mean_se(c).mean);
-  int compared = 0;
-  double chi2 = 0, max_z = 0, total = 0, var_a = 0, var_b = 0;
-  for (size_t c = 0; c < a.size(); ++c) {
-    const MeanSE x = mean_se(a[c]), y = mean_se(b[c]);
-    total += x.mean;
-    var_a += x.se * x.se;
-    var_b += y.se * y.se;
-    if (std::max(x.mean, y.mean) < 0.02 * peak) continue;
-    const double z = (x.mean - y.mean) / std::sqrt(x.se * x.se + y.se * y.se);
-    chi2 += z * z;
-    max_z = std::max(max_z, std::abs(z));
-    ++compared;
-  }
-  INFO("cells " << compared << ", max |z| " << max_z << ", chi2 " << chi2
-                << ", relative SE of the total " << std::sqrt(var_a) / total << " and "
-                << std::sqrt(var_b) / total);
-  REQUIRE(compared >= min_cells);
-  CHECK(max_z < 4.0);
-  CHECK(stats::chi2_survival(chi2, compared) > 1e-3);
-  CHECK(std::sqrt(var_a + var_b) / total < resolution);
-}
 
 /// Fog in a box over a floor, a glass sphere inside it, and `light` (JSON) above: the camera
 /// looks at the fog and the floor beside the sphere, not through it.
@@ -336,8 +207,8 @@ TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog"
   pd.per_pass = 20000;
   pd.radius = 0.8;
   pd.bandwidth_ps = 1.0;
-  const auto pt = cells(runs(scene, IntegratorKind::Path, 192, 24, 800), 4, 2);
-  const auto hy = cells(runs(scene, IntegratorKind::Hybrid, 64, 24, 900, pd), 4, 2);
+  const auto pt = cells(batches(scene, IntegratorKind::Path, 192, 24, 800), 4, 2);
+  const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 64, 24, 900, pd), 4, 2);
   require_agreement(pt, hy, 12, 0.025);  // a 10% error would be 4 standard errors
 }
 
@@ -363,6 +234,6 @@ TEST_CASE("hybrid agrees with light tracing on a volumetric caustic from a point
     opt.quiet = true;
     lt.push_back(render(scene, opt).film);
   }
-  const auto hy = cells(runs(scene, IntegratorKind::Hybrid, 64, 24, 1100, pd), 4, 2);
+  const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 64, 24, 1100, pd), 4, 2);
   require_agreement(hy, cells(lt, 4, 2), 12);
 }
