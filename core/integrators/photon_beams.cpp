@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "core/constants.h"
+#include "core/transport/chunked_paths.h"
 #include "core/transport/light_walk.h"
 #include "media/phase_hg.h"
 
@@ -148,46 +149,28 @@ void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, do
 std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64_t count,
                               int max_depth, double t_cut_ps, PathStats& stats, bool caustic_only) {
   const MediumTracker tracker(scene);
-  const int64_t chunks = (count + kChunk - 1) / kChunk;
-  std::vector<std::vector<Beam>> per_chunk(static_cast<size_t>(chunks));
-  tbb::enumerable_thread_specific<PathStats> local;
-  tbb::parallel_for(
-      tbb::blocked_range<int64_t>(0, chunks, 1), [&](const tbb::blocked_range<int64_t>& r) {
-        PathStats& st = local.local();
-        for (int64_t c = r.begin(); c != r.end(); ++c) {
-          std::vector<Beam>& out = per_chunk[static_cast<size_t>(c)];
-          const int64_t end = std::min(count, (c + 1) * kChunk);
-          for (int64_t i = c * kChunk; i < end; ++i) {
-            Rng rng = Rng::for_sample(seed, kBeamStream + static_cast<uint64_t>(pass),
-                                      static_cast<uint64_t>(i));
-            walk_light_path(
-                scene, tracker, rng, max_depth, t_cut_ps, st,
-                [&](const LightVertex& v) {
-                  // A caustic path is over once it scatters off a diffuse surface or in a medium.
-                  if (caustic_only && v.chain < 0) return false;
-                  if (v.kind != LightVertex::Kind::Segment) return true;
-                  if (caustic_only && v.chain < 1) return true;
-                  // Beyond the window's end nothing it lights can be seen (eta >= 1: time >=
-                  // distance / c).
-                  const double reach = (t_cut_ps - v.t_ps) * kSpeedOfLight;
-                  const double length = std::fmin(v.length, reach);
-                  if (length > 0) {
-                    out.push_back({v.p, v.d, length, v.beta, v.t_ps, v.sigma_ps, v.g, v.medium});
-                    ++st.beams_stored;
-                  }
-                  return true;
-                },
-                /*segments=*/true);
-          }
-        }
+  return trace_in_chunks<Beam>(
+      count, kChunk, stats, [&](int64_t i, std::vector<Beam>& out, PathStats& st) {
+        Rng rng = Rng::for_sample(seed, kBeamStream + static_cast<uint64_t>(pass),
+                                  static_cast<uint64_t>(i));
+        walk_light_path(
+            scene, tracker, rng, max_depth, t_cut_ps, st,
+            [&](const LightVertex& v) {
+              // A caustic path is over once it scatters off a diffuse surface or in a medium.
+              if (caustic_only && v.chain < 0) return false;
+              if (v.kind != LightVertex::Kind::Segment) return true;
+              if (caustic_only && v.chain < 1) return true;
+              // Beyond the window's end nothing it lights can be seen (eta >= 1: time >= distance /
+              // c).
+              const double length = std::fmin(v.length, (t_cut_ps - v.t_ps) * kSpeedOfLight);
+              if (length > 0) {
+                out.push_back({v.p, v.d, length, v.beta, v.t_ps, v.sigma_ps, v.g, v.medium});
+                ++st.beams_stored;
+              }
+              return true;
+            },
+            /*segments=*/true);
       });
-  for (const PathStats& s : local) stats += s;
-  size_t total = 0;
-  for (const auto& v : per_chunk) total += v.size();
-  std::vector<Beam> beams;
-  beams.reserve(total);
-  for (const auto& v : per_chunk) beams.insert(beams.end(), v.begin(), v.end());
-  return beams;
 }
 
 }  // namespace femto

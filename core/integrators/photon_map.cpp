@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "core/constants.h"
+#include "core/transport/chunked_paths.h"
 #include "core/transport/light_walk.h"
 
 namespace femto {
@@ -79,40 +80,20 @@ void PhotonGather::gather(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& 
 std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count,
                                   int max_depth, double t_cut_ps, PathStats& stats) {
   const MediumTracker tracker(scene);
-  const int64_t chunks = (count + kChunk - 1) / kChunk;
-  std::vector<std::vector<Photon>> per_chunk(static_cast<size_t>(chunks));
-  tbb::enumerable_thread_specific<PathStats> local;
-  tbb::parallel_for(
-      tbb::blocked_range<int64_t>(0, chunks, 1), [&](const tbb::blocked_range<int64_t>& r) {
-        PathStats& st = local.local();
-        for (int64_t c = r.begin(); c != r.end(); ++c) {
-          std::vector<Photon>& out = per_chunk[static_cast<size_t>(c)];
-          const int64_t end = std::min(count, (c + 1) * kChunk);
-          for (int64_t i = c * kChunk; i < end; ++i) {
-            Rng rng = Rng::for_sample(seed, kPhotonStream + static_cast<uint64_t>(pass),
-                                      static_cast<uint64_t>(i));
-            walk_light_path(scene, tracker, rng, max_depth, t_cut_ps, st,
-                            [&](const LightVertex& v) {
-                              if (v.kind != LightVertex::Kind::Surface)
-                                return v.kind == LightVertex::Kind::Emitter;
-                              if (!v.bsdf->is_diffuse())
-                                return true;       // glossy and specular chains go on
-                              if (v.chain >= 1) {  // light -> non-diffuse surfaces -> here
-                                out.push_back({v.p, v.hit->ng, -v.d, v.beta, v.t_ps, v.sigma_ps});
-                                ++st.photons_stored;
-                              }
-                              return false;  // after a diffuse vertex the camera paths take over
-                            });
+  return trace_in_chunks<Photon>(
+      count, kChunk, stats, [&](int64_t i, std::vector<Photon>& out, PathStats& st) {
+        Rng rng = Rng::for_sample(seed, kPhotonStream + static_cast<uint64_t>(pass),
+                                  static_cast<uint64_t>(i));
+        walk_light_path(scene, tracker, rng, max_depth, t_cut_ps, st, [&](const LightVertex& v) {
+          if (v.kind != LightVertex::Kind::Surface) return v.kind == LightVertex::Kind::Emitter;
+          if (!v.bsdf->is_diffuse()) return true;  // glossy and specular chains go on
+          if (v.chain >= 1) {                      // light -> non-diffuse surfaces -> here
+            out.push_back({v.p, v.hit->ng, -v.d, v.beta, v.t_ps, v.sigma_ps});
+            ++st.photons_stored;
           }
-        }
+          return false;  // after a diffuse vertex the camera paths take over
+        });
       });
-  for (const PathStats& s : local) stats += s;
-  size_t total = 0;
-  for (const auto& v : per_chunk) total += v.size();
-  std::vector<Photon> photons;
-  photons.reserve(total);
-  for (const auto& v : per_chunk) photons.insert(photons.end(), v.begin(), v.end());
-  return photons;
 }
 
 }  // namespace femto

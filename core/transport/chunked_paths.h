@@ -1,0 +1,42 @@
+#pragma once
+// Light paths traced in parallel in fixed chunks, their records gathered in path order: the list
+// is the same for any thread count (each path has its own random stream; a chunk's records stay
+// together, and chunks are concatenated in order).
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "core/transport/tracker.h"
+
+namespace femto {
+
+/// Calls trace(i, out, stats) for every path i in [0, count), `chunk` paths per task; `out` is the
+/// chunk's std::vector<T>. Counters are summed into `stats`.
+template <class T, class Trace>
+std::vector<T> trace_in_chunks(int64_t count, int64_t chunk, PathStats& stats, Trace&& trace) {
+  const int64_t chunks = (count + chunk - 1) / chunk;
+  std::vector<std::vector<T>> per_chunk(static_cast<size_t>(chunks));
+  tbb::enumerable_thread_specific<PathStats> local;
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, chunks, 1),
+                    [&](const tbb::blocked_range<int64_t>& r) {
+                      PathStats& st = local.local();
+                      for (int64_t c = r.begin(); c != r.end(); ++c) {
+                        std::vector<T>& out = per_chunk[static_cast<size_t>(c)];
+                        const int64_t end = std::min(count, (c + 1) * chunk);
+                        for (int64_t i = c * chunk; i < end; ++i) trace(i, out, st);
+                      }
+                    });
+  for (const PathStats& s : local) stats += s;
+  size_t total = 0;
+  for (const auto& v : per_chunk) total += v.size();
+  std::vector<T> all;
+  all.reserve(total);
+  for (const auto& v : per_chunk) all.insert(all.end(), v.begin(), v.end());
+  return all;
+}
+
+}  // namespace femto
