@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <fstream>
+#include <utility>
 
 namespace femto {
 namespace {
@@ -69,6 +70,23 @@ class Reader {
   uint64_t pos_ = 0;
 };
 
+// The value size of OpenVDB's fixed-size metadata types (Types.h, typeNameAsString), or 0.
+// OpenVDB reads these with their own size whatever size the file states, so a wrong stated size
+// would make it read the rest of the file out of step (e.g. a string length taken from a float).
+uint32_t fixed_metadata_size(const std::string& type) {
+  static const std::pair<const char*, uint32_t> kSizes[] = {
+      {"bool", 1},    {"half", 2},     {"float", 4},   {"double", 8},   {"int8", 1},
+      {"uint8", 1},   {"int16", 2},    {"uint16", 2},  {"int32", 4},    {"uint32", 4},
+      {"int64", 8},   {"vec2i", 8},    {"vec2s", 8},   {"vec2d", 16},   {"vec3u8", 3},
+      {"vec3u16", 6}, {"vec3i", 12},   {"vec3s", 12},  {"vec3d", 24},   {"vec4i", 16},
+      {"vec4s", 16},  {"vec4d", 32},   {"mat3s", 36},  {"mat3d", 72},   {"mat4s", 64},
+      {"mat4d", 128}, {"quats", 16},   {"quatd", 32},  {"ptidx32", 4},  {"ptidx64", 8},
+      {"ptdataidx32", 4}, {"ptdataidx64", 8}};
+  for (const auto& [name, size] : kSizes)
+    if (type == name) return size;
+  return 0;
+}
+
 // A metadata map: count, then (name, type name, size, value) per entry.
 void check_metadata(Reader& r, const std::string& where) {
   const int32_t count = r.read<int32_t>(where + " metadata count");
@@ -76,8 +94,18 @@ void check_metadata(Reader& r, const std::string& where) {
   for (int32_t i = 0; i < count; ++i) {
     const std::string entry = where + " metadata entry " + std::to_string(i + 1);
     r.string(entry + " name");
-    r.string(entry + " type");
-    r.skip(r.read<uint32_t>(entry + " size"), entry + " value");
+    const std::string type = r.string(entry + " type");
+    const uint32_t size = r.read<uint32_t>(entry + " size");
+    const uint32_t fixed = fixed_metadata_size(type);
+    if (fixed != 0 && size != fixed)
+      throw Bad{entry + " of type " + type.substr(0, 16) + " claims " + std::to_string(size) +
+                " bytes; the type has " + std::to_string(fixed)};
+    if (type == "bool") {  // read into a C++ bool: any byte but 0 or 1 is undefined behaviour
+      if (static_cast<unsigned char>(r.read<char>(entry + " value")) > 1)
+        throw Bad{entry + " is a bool but is neither 0 nor 1"};
+    } else {
+      r.skip(size, entry + " value");
+    }
   }
 }
 
@@ -119,6 +147,9 @@ void check_grid(Reader& r, uint32_t version, int index) {
       throw Bad{where + " has unknown compression flags " + std::to_string(compression)};
   }
   check_metadata(r, where);
+  // The transform follows (file versions from 219 on), starting with its map's type name, which
+  // OpenVDB reads into a string of the stated length before looking the name up.
+  r.string(where + " transform type");
   r.set_end(r.size());
   r.seek(static_cast<uint64_t>(end));
 }

@@ -61,7 +61,37 @@ std::string damaged(const fs::path& dir, size_t at, unsigned mask) {
   return path;
 }
 
+// cloud.vdb with `bytes` written over it at `at`.
+std::string patched(const fs::path& dir, size_t at, const std::string& bytes) {
+  std::string data = test::read_file(example_volume());
+  data.replace(at, bytes.size(), bytes);
+  const std::string path = (dir / "patched.vdb").string();
+  test::write_file(path, data);
+  return path;
+}
+
 }  // namespace
+
+// Was (found by fuzz/fuzz_vdb.cpp): a metadata type name changed from "vec3i" to "int32" kept
+// its stated size of 12 bytes; OpenVDB reads 4 and takes the next string's length from the
+// values left over, allocating and filling 1.7 GB twice for a 10 KB file.
+// fuzz/regressions/vdb/metadata-type-size.vdb is the fuzzer's input.
+TEST_CASE("a metadata value whose stated size differs from its type's is refused", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  // cloud.vdb: grid metadata 'file_bbox_max' of type vec3i at 0xba, 'file_mem_bytes' (int64) at 0x42b.
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0xba, "int32")),
+             Contains("of type int32 claims 12 bytes; the type has 4"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x42b, "int32")),
+             Contains("of type int32 claims 8 bytes; the type has 4"));
+  CHECK_THAT(load_error(patched(tmp.dir, 0xba, "int32")),
+             Contains("patched.vdb: corrupt or unsupported OpenVDB file: grid 1 metadata entry 2"));
+  // The transform's map type name (length at 0x482, "UniformScaleTranslateMap") is read into a
+  // string of the stated length: bounded like every other string, and inside the grid.
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x482, std::string("\xff\xff\xff\x7f", 4))),
+             Contains("grid 1 transform type claims 2147483647 bytes, above the 1 MiB limit"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x482, std::string("\x00\x00\x0f\x00", 4))),
+             Contains("grid 1 transform type claims 983040 bytes") && Contains("remain"));
+}
 
 // Was: SIGSEGV: the box size x_max - x_min + 1 overflowed int to 0 cells, densify wrote via null.
 TEST_CASE("voxels at INT_MIN and INT_MAX are refused by 64-bit box arithmetic", "[robust]") {
