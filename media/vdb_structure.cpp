@@ -23,6 +23,7 @@ class Reader {
   Reader(std::ifstream& in, uint64_t size) : in_(in), end_(size), size_(size) {}
 
   uint64_t pos() const { return pos_; }
+  uint64_t end() const { return end_; }
   uint64_t size() const { return size_; }
   void set_end(uint64_t end) { end_ = end; }
 
@@ -124,12 +125,62 @@ uint32_t check_header(Reader& r) {
   return offsets ? version : 0;
 }
 
-// One grid descriptor (name, type, parent, three offsets) and the grid's own metadata.
+// Bytes after the type name of OpenVDB's linear maps (math/Maps.h, read()), or 0 if unknown.
+uint64_t linear_map_bytes(const std::string& type) {
+  if (type == "AffineMap" || type == "UnitaryMap") return 128;  // a 4x4 double matrix
+  if (type == "ScaleMap" || type == "UniformScaleMap") return 120;  // five double vectors
+  if (type == "ScaleTranslateMap" || type == "UniformScaleTranslateMap") return 144;  // six
+  if (type == "TranslationMap") return 24;
+  return 0;
+}
+
+// A transform: its map's type name (which OpenVDB reads into a string of the stated length
+// before looking the name up), then the map. A frustum holds a box, taper and depth, and a
+// second, linear map.
+void check_transform(Reader& r, uint32_t version, const std::string& where) {
+  const std::string type = r.string(where + " transform type");
+  if (type == "NonlinearFrustumMap") {
+    r.skip(version >= 221 ? 48 + 16 : 24 + 16, where + " frustum");  // box as doubles from 221
+    const std::string second = r.string(where + " frustum map type");
+    const uint64_t n = linear_map_bytes(second);
+    if (n == 0) throw Bad{where + " frustum has an unknown map type '" + second.substr(0, 40) + "'"};
+    r.skip(n, where + " frustum map");
+    return;
+  }
+  const uint64_t n = linear_map_bytes(type);
+  if (n == 0) throw Bad{where + " has an unknown transform type '" + type.substr(0, 40) + "'"};
+  r.skip(n, where + " transform");
+}
+
+// The start of a float tree's topology (tree/Tree.h and tree/RootNode.h, readTopology): the
+// buffer count, the root's background, its tiles (origin, value, active flag) and the number of
+// its children. OpenVDB reads as many tiles and children as stated, allocating a 270 KB node per
+// child even past the end of the file, and reads each tile's active flag into a C++ bool.
+void check_float_root(Reader& r, const std::string& where) {
+  r.skip(4 + 4, where + " buffer count and background");
+  const uint32_t tiles = r.read<uint32_t>(where + " root tile count");
+  const uint32_t children = r.read<uint32_t>(where + " root child count");
+  const uint64_t tile_bytes = 12 + 4 + 1;
+  const uint64_t child_bytes = 12 + 2 * 4096;  // origin, child mask and value mask at least
+  const uint64_t left = r.end() - r.pos();
+  if (uint64_t(tiles) * tile_bytes + uint64_t(children) * child_bytes > left)
+    throw Bad{where + " root claims " + std::to_string(tiles) + " tiles and " +
+              std::to_string(children) + " children, more than the " + std::to_string(left) +
+              " bytes of its topology can hold"};
+  for (uint32_t i = 0; i < tiles; ++i) {
+    r.skip(12 + 4, where + " root tile");
+    if (static_cast<unsigned char>(r.read<char>(where + " root tile flag")) > 1)
+      throw Bad{where + " root tile " + std::to_string(i + 1) + " has an active flag that is neither 0 nor 1"};
+  }
+}
+
+// One grid descriptor (name, type, parent, three offsets), the grid's own metadata, its
+// transform and, for a float grid, the start of its tree.
 void check_grid(Reader& r, uint32_t version, int index) {
   const std::string where = "grid " + std::to_string(index + 1);
   r.string(where + " name");
-  r.string(where + " type");
-  r.string(where + " instance parent");
+  const std::string type = r.string(where + " type");
+  const bool instance = !r.string(where + " instance parent").empty();  // shares another's tree
   const int64_t grid = r.read<int64_t>(where + " offset");
   const int64_t block = r.read<int64_t>(where + " data offset");
   const int64_t end = r.read<int64_t>(where + " end offset");
@@ -147,9 +198,9 @@ void check_grid(Reader& r, uint32_t version, int index) {
       throw Bad{where + " has unknown compression flags " + std::to_string(compression)};
   }
   check_metadata(r, where);
-  // The transform follows (file versions from 219 on), starting with its map's type name, which
-  // OpenVDB reads into a string of the stated length before looking the name up.
-  r.string(where + " transform type");
+  check_transform(r, version, where);  // after the metadata from file version 216 on
+  if (!instance && (type == "Tree_float_5_4_3" || type == "Tree_float_5_4_3_HalfFloat"))
+    check_float_root(r, where);
   r.set_end(r.size());
   r.seek(static_cast<uint64_t>(end));
 }

@@ -93,6 +93,30 @@ TEST_CASE("a metadata value whose stated size differs from its type's is refused
              Contains("grid 1 transform type claims 983040 bytes") && Contains("remain"));
 }
 
+// Was (found by fuzz/fuzz_vdb.cpp): a root tile's active flag of 2 read into a C++ bool inside
+// OpenVDB's RootNode::readTopology (undefined behaviour, reported by UBSan); and a stated child
+// count of 2^32 - 1 made OpenVDB allocate a 270 KB node per child, reading past the end of the
+// file. fuzz/regressions/vdb/root-tile-flag.vdb is the fuzzer's input.
+TEST_CASE("the root node's tiles and children must fit the grid's topology", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  // cloud.vdb: the density tree starts at 0x52e (buffer count 1, background 0, 0 tiles at
+  // 0x536, 1 child at 0x53a, then the child's origin and masks).
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x53a, std::string("\xff\xff\xff\xff", 4))),
+             Contains("grid 1 root claims 0 tiles and 4294967295 children, more than the"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x536, std::string("\xff\xff\xff\x0f", 4))),
+             Contains("grid 1 root claims 268435455 tiles and 1 children"));
+  // One tile (origin, value, flag at 0x54e) in front of the child.
+  CHECK(vdb_structure_problem(patched(tmp.dir, 0x536, std::string("\x01\x00\x00\x00", 4))).empty());
+  std::string tile_flag_2(0x54f - 0x536, '\0');
+  tile_flag_2[0] = '\x01';
+  tile_flag_2.back() = '\x02';
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x536, tile_flag_2)),
+             Contains("grid 1 root tile 1 has an active flag that is neither 0 nor 1"));
+  // Transform types are known ones with their own sizes.
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x486, "UniformScaleTranslateMaq")),
+             Contains("grid 1 has an unknown transform type 'UniformScaleTranslateMaq'"));
+}
+
 // Was: SIGSEGV: the box size x_max - x_min + 1 overflowed int to 0 cells, densify wrote via null.
 TEST_CASE("voxels at INT_MIN and INT_MAX are refused by 64-bit box arithmetic", "[robust]") {
   test::TempDir tmp("femto_bad_vdb");
