@@ -1,8 +1,11 @@
 #include "media/vdb_structure.h"
 
+#include <array>
 #include <cstdint>
 #include <fstream>
+#include <map>
 #include <utility>
+#include <vector>
 
 namespace femto {
 namespace {
@@ -11,7 +14,8 @@ constexpr int64_t kMagic = 0x56444220;  // "VDB " as a little-endian int64
 constexpr uint32_t kOldestVersion = 219;  // file format with grid offsets and no grid map
 constexpr uint32_t kNewestVersion = 224;  // what the linked OpenVDB 10 writes
 constexpr uint32_t kMaxString = 1u << 20;  // names and type names; real ones are short
-constexpr uint32_t kKnownCompression = 0x7;  // zip | active mask | blosc
+constexpr uint32_t kZip = 0x1, kActiveMask = 0x2, kBlosc = 0x4;
+constexpr uint32_t kKnownCompression = kZip | kActiveMask | kBlosc;
 
 struct Bad {
   std::string what;
@@ -110,8 +114,12 @@ void check_metadata(Reader& r, const std::string& where) {
   }
 }
 
-// The file version, or 0 for a file without grid offsets (a stream: only its header is checked).
-uint32_t check_header(Reader& r) {
+struct Header {
+  uint32_t version = 0;      ///< 0 for a file without grid offsets (a stream: only its header is checked)
+  uint32_t compression = 0;  ///< the file's compression before version 222 (per grid after)
+};
+
+Header check_header(Reader& r) {
   if (r.read<int64_t>("the magic number") != kMagic) throw Bad{"not an OpenVDB file (bad magic number)"};
   const uint32_t version = r.read<uint32_t>("the file version");
   if (version < kOldestVersion || version > kNewestVersion)
@@ -119,10 +127,13 @@ uint32_t check_header(Reader& r) {
               std::to_string(kOldestVersion) + " to " + std::to_string(kNewestVersion) + ")"};
   r.skip(8, "the library version");
   const bool offsets = r.read<char>("the grid-offsets flag") != 0;
-  if (version < 222) r.skip(1, "the compression flag");  // per grid from version 222 on
+  Header h;
+  if (version < 222)  // per grid from version 222 on
+    h.compression = r.read<char>("the compression flag") != 0 ? kZip : 0;
   r.skip(36, "the file UUID");
   check_metadata(r, "file");
-  return offsets ? version : 0;
+  h.version = offsets ? version : 0;
+  return h;
 }
 
 // Bytes after the type name of OpenVDB's linear maps (math/Maps.h, read()), or 0 if unknown.
@@ -152,31 +163,148 @@ void check_transform(Reader& r, uint32_t version, const std::string& where) {
   r.skip(n, where + " transform");
 }
 
-// The start of a float tree's topology (tree/Tree.h and tree/RootNode.h, readTopology): the
-// buffer count, the root's background, its tiles (origin, value, active flag) and the number of
-// its children. OpenVDB reads as many tiles and children as stated, allocating a 270 KB node per
-// child even past the end of the file, and reads each tile's active flag into a C++ bool.
-void check_float_root(Reader& r, const std::string& where) {
-  r.skip(4 + 4, where + " buffer count and background");
-  const uint32_t tiles = r.read<uint32_t>(where + " root tile count");
-  const uint32_t children = r.read<uint32_t>(where + " root child count");
-  const uint64_t tile_bytes = 12 + 4 + 1;
-  const uint64_t child_bytes = 12 + 2 * 4096;  // origin, child mask and value mask at least
-  const uint64_t left = r.end() - r.pos();
-  if (uint64_t(tiles) * tile_bytes + uint64_t(children) * child_bytes > left)
-    throw Bad{where + " root claims " + std::to_string(tiles) + " tiles and " +
-              std::to_string(children) + " children, more than the " + std::to_string(left) +
-              " bytes of its topology can hold"};
-  for (uint32_t i = 0; i < tiles; ++i) {
-    r.skip(12 + 4, where + " root tile");
-    if (static_cast<unsigned char>(r.read<char>(where + " root tile flag")) > 1)
-      throw Bad{where + " root tile " + std::to_string(i + 1) + " has an active flag that is neither 0 nor 1"};
+// A float tree's node masks and value arrays (tree/InternalNode.h, tree/LeafNode.h,
+// io/Compression.h). OpenVDB 10 reads an uncompressed chunk of the stated size into a buffer
+// sized for the node and checks the size afterwards (a heap overflow), allocates compressed
+// chunks of the stated size, and indexes the active values by the node's value mask. So every
+// chunk is checked here against the size its node gives it, with the topology (in front of the
+// grid's data offset) and the buffers (after it) walked side by side.
+class FloatTreeCheck {
+ public:
+  FloatTreeCheck(Reader& topology, Reader& buffers, uint32_t version, uint32_t compression,
+                 bool half, std::string where)
+      : topo_(topology), buf_(buffers), version_(version), compression_(compression),
+        value_bytes_(half ? 2 : 4), where_(std::move(where)) {}
+
+  /// The root's tiles and children; then each child's branch in the order OpenVDB reads their
+  /// buffers: by origin, the last of children with the same origin.
+  void root() {
+    topo_.skip(4 + 4, where_ + " buffer count and background");
+    const uint32_t tiles = topo_.read<uint32_t>(where_ + " root tile count");
+    const uint32_t children = topo_.read<uint32_t>(where_ + " root child count");
+    const uint64_t tile_bytes = 12 + 4 + 1;
+    const uint64_t child_bytes = 12 + 2 * 4096;  // origin, child mask and value mask at least
+    const uint64_t left = topo_.end() - topo_.pos();
+    if (uint64_t(tiles) * tile_bytes + uint64_t(children) * child_bytes > left)
+      throw Bad{where_ + " root claims " + std::to_string(tiles) + " tiles and " +
+                std::to_string(children) + " children, more than the " + std::to_string(left) +
+                " bytes of its topology can hold"};
+    for (uint32_t i = 0; i < tiles; ++i) {  // the active flag is read into a C++ bool
+      topo_.skip(12 + 4, where_ + " root tile");
+      if (static_cast<unsigned char>(topo_.read<char>(where_ + " root tile flag")) > 1)
+        throw Bad{where_ + " root tile " + std::to_string(i + 1) +
+                  " has an active flag that is neither 0 nor 1"};
+    }
+    std::map<std::array<int32_t, 3>, uint64_t> branches;  // origin -> start of its topology
+    for (uint32_t i = 0; i < children; ++i) {
+      std::array<int32_t, 3> origin;
+      for (int32_t& c : origin) c = topo_.read<int32_t>(where_ + " root child origin");
+      branches[origin] = topo_.pos();
+      node(2, false);
+    }
+    const uint64_t end = topo_.pos();
+    for (const auto& branch : branches) {
+      topo_.seek(branch.second);
+      node(2, true);
+    }
+    topo_.seek(end);
   }
-}
+
+ private:
+  using Mask = std::vector<uint64_t>;
+
+  static uint64_t count_on(const Mask& m) {
+    uint64_t n = 0;
+    for (const uint64_t w : m) n += static_cast<uint64_t>(__builtin_popcountll(w));
+    return n;
+  }
+
+  Mask mask(Reader& r, uint64_t bits, const std::string& what) {
+    Mask m(bits / 64);
+    for (uint64_t& w : m) w = r.read<uint64_t>(what);
+    return m;
+  }
+
+  // readData: `bytes` of values, stored raw or as one zip or blosc chunk.
+  void data(Reader& r, uint64_t bytes, uint32_t compression) {
+    const std::string what = where_ + " value chunk at offset " + std::to_string(r.pos());
+    if (!(compression & (kZip | kBlosc))) {
+      r.skip(bytes, what);
+      return;
+    }
+    const int64_t n = r.read<int64_t>(what);
+    if (n <= 0) {  // stored uncompressed: OpenVDB reads -n bytes into a buffer of `bytes`
+      const uint64_t raw = 0 - static_cast<uint64_t>(n);
+      if (raw != bytes)
+        throw Bad{what + " holds " + std::to_string(raw) + " uncompressed bytes where the node has " +
+                  std::to_string(bytes)};
+      r.skip(raw, what);
+      return;
+    }
+    if (compression & kBlosc) {  // blosc header: uncompressed size at 4, compressed size at 12
+      if (n < 16) throw Bad{what + " is shorter than a blosc header"};
+      r.skip(4, what);
+      const uint32_t full = r.read<uint32_t>(what);
+      r.skip(4, what);
+      const uint32_t packed = r.read<uint32_t>(what);
+      if (full < bytes || packed > static_cast<uint64_t>(n))
+        throw Bad{what + " has a blosc header for " + std::to_string(full) + " bytes in " +
+                  std::to_string(packed) + " where the node has " + std::to_string(bytes) +
+                  " bytes in " + std::to_string(n)};
+      r.skip(static_cast<uint64_t>(n) - 16, what);
+      return;
+    }
+    r.skip(static_cast<uint64_t>(n), what);  // zlib bounds its output itself
+  }
+
+  // readCompressedValues: `count` values of a node with value mask `on`.
+  void values(Reader& r, uint64_t count, const Mask& on) {
+    int8_t meta = 6;  // NO_MASK_AND_ALL_VALS
+    if (version_ >= 222) meta = r.read<int8_t>(where_ + " node value flags");
+    if (meta == 2 || meta == 4 || meta == 5) r.skip(meta == 5 ? 8 : 4, where_ + " inactive values");
+    if (meta == 3 || meta == 4 || meta == 5) r.skip(on.size() * 8, where_ + " selection mask");
+    if ((compression_ & kActiveMask) && meta != 6 && version_ >= 222) count = count_on(on);
+    data(r, count * value_bytes_, compression_);
+  }
+
+  // A node at `level` (2 and 1: internal nodes of 32^3 and 16^3 children, 0: a leaf), with its
+  // buffers when `buffers`.
+  void node(int level, bool buffers) {
+    if (level == 0) {
+      const Mask on = mask(topo_, 512, where_ + " leaf value mask");
+      if (!buffers) return;
+      if (mask(buf_, 512, where_ + " leaf value mask") != on)
+        throw Bad{where_ + " leaf value mask at offset " + std::to_string(buf_.pos() - 64) +
+                  " differs from the tree's"};
+      int8_t extra = 0;
+      if (version_ < 222) {
+        buf_.skip(12, where_ + " leaf origin");
+        extra = static_cast<int8_t>(buf_.read<int8_t>(where_ + " leaf buffer count") - 1);
+      }
+      values(buf_, 512, on);
+      for (int i = 0; i < extra; ++i) data(buf_, 512 * value_bytes_, compression_ & kZip);
+      return;
+    }
+    const uint64_t bits = level == 2 ? 32768 : 4096;
+    const Mask child = mask(topo_, bits, where_ + " node child mask");
+    const Mask on = mask(topo_, bits, where_ + " node value mask");
+    values(topo_, version_ < 222 ? bits - count_on(child) : bits, on);
+    for (size_t w = 0; w < child.size(); ++w)
+      for (int b = 0; b < 64; ++b)
+        if (child[w] >> b & 1) node(level - 1, buffers);
+  }
+
+  Reader& topo_;
+  Reader& buf_;
+  uint32_t version_, compression_;
+  uint64_t value_bytes_;
+  std::string where_;
+};
 
 // One grid descriptor (name, type, parent, three offsets), the grid's own metadata, its
-// transform and, for a float grid, the start of its tree.
-void check_grid(Reader& r, uint32_t version, int index) {
+// transform and, for a float grid, its tree.
+void check_grid(Reader& r, Reader& data, const Header& h, int index) {
+  const uint32_t version = h.version;
   const std::string where = "grid " + std::to_string(index + 1);
   r.string(where + " name");
   const std::string type = r.string(where + " type");
@@ -192,15 +320,20 @@ void check_grid(Reader& r, uint32_t version, int index) {
               std::to_string(r.size()) + " bytes"};
   r.seek(static_cast<uint64_t>(grid));
   r.set_end(static_cast<uint64_t>(block));
+  uint32_t compression = h.compression;
   if (version >= 222) {
-    const uint32_t compression = r.read<uint32_t>(where + " compression flags");
+    compression = r.read<uint32_t>(where + " compression flags");
     if (compression & ~kKnownCompression)
       throw Bad{where + " has unknown compression flags " + std::to_string(compression)};
   }
   check_metadata(r, where);
   check_transform(r, version, where);  // after the metadata from file version 216 on
-  if (!instance && (type == "Tree_float_5_4_3" || type == "Tree_float_5_4_3_HalfFloat"))
-    check_float_root(r, where);
+  const bool half = type == "Tree_float_5_4_3_HalfFloat";
+  if (!instance && (type == "Tree_float_5_4_3" || half)) {
+    data.seek(static_cast<uint64_t>(block));
+    data.set_end(static_cast<uint64_t>(end));
+    FloatTreeCheck(r, data, version, compression, half, where).root();
+  }
   r.set_end(r.size());
   r.seek(static_cast<uint64_t>(end));
 }
@@ -214,13 +347,16 @@ std::string vdb_structure_problem(const std::string& path) {
   if (size < 0) return "cannot read the file size";
   in.seekg(0);
   Reader r(in, static_cast<uint64_t>(size));
+  std::ifstream in_data(path, std::ios::binary);  // a second position: a grid's buffers
+  if (!in_data) return "cannot open the file";
+  Reader data(in_data, static_cast<uint64_t>(size));
   try {
-    const uint32_t version = check_header(r);
-    if (version == 0) return "";
+    const Header h = check_header(r);
+    if (h.version == 0) return "";
     const int32_t grids = r.read<int32_t>("the grid count");
     if (grids < 0 || static_cast<uint64_t>(grids) > r.size() / 36)  // 36: smallest descriptor
       return "the grid count " + std::to_string(grids) + " does not fit the file";
-    for (int32_t i = 0; i < grids; ++i) check_grid(r, version, i);
+    for (int32_t i = 0; i < grids; ++i) check_grid(r, data, h, i);
   } catch (const Bad& b) {
     return b.what;
   }
