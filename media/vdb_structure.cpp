@@ -115,7 +115,7 @@ void check_metadata(Reader& r, const std::string& where) {
 }
 
 struct Header {
-  uint32_t version = 0;      ///< 0 for a file without grid offsets (a stream: only its header is checked)
+  uint32_t version = 0;      ///< 0 for a file without grid offsets (written as a stream)
   uint32_t compression = 0;  ///< the file's compression before version 222 (per grid after)
 };
 
@@ -352,7 +352,12 @@ std::string vdb_structure_problem(const std::string& path) {
   Reader data(in_data, static_cast<uint64_t>(size));
   try {
     const Header h = check_header(r);
-    if (h.version == 0) return "";
+    // Without grid offsets (a file written by openvdb::io::Stream) OpenVDB reads every grid in
+    // turn, and where one ends is only known by reading it: such files are not checked, so not
+    // read. openvdb::io::File, which the common tools use, always writes the offsets.
+    if (h.version == 0)
+      return "the file has no grid offsets (it was written as an OpenVDB stream); femto reads "
+             "files written with openvdb::io::File";
     const int32_t grids = r.read<int32_t>("the grid count");
     if (grids < 0 || static_cast<uint64_t>(grids) > r.size() / 36)  // 36: smallest descriptor
       return "the grid count " + std::to_string(grids) + " does not fit the file";

@@ -141,6 +141,16 @@ TEST_CASE("value chunks must have the size of their node", "[robust]") {
   CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x567c, 0x01)), Contains("differs from the tree's"));
 }
 
+// Was (found by fuzz/fuzz_vdb.cpp): with the grid-offsets flag cleared, OpenVDB reads the file
+// as a stream, grid after grid, and the structure check (which locates grids by their offsets)
+// did not look past the header: a corrupt metadata size then asked for 2.7 GB.
+// fuzz/regressions/vdb/no-grid-offsets.vdb is the fuzzer's input.
+TEST_CASE("files without grid offsets are refused", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x14, 0x01)),
+             Contains("no grid offsets (it was written as an OpenVDB stream)"));
+}
+
 // Was: SIGSEGV: the box size x_max - x_min + 1 overflowed int to 0 cells, densify wrote via null.
 TEST_CASE("voxels at INT_MIN and INT_MAX are refused by 64-bit box arithmetic", "[robust]") {
   test::TempDir tmp("femto_bad_vdb");
