@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <fstream>
 #include <map>
 #include <utility>
@@ -92,6 +93,45 @@ uint32_t fixed_metadata_size(const std::string& type) {
   return 0;
 }
 
+// A blosc chunk of `bytes` bytes that must hold `expect` bytes: its header's sizes (blosc trusts
+// the compressed size in its header, not the buffer it is given).
+void check_blosc(Reader& r, uint64_t bytes, uint64_t expect, const std::string& what) {
+  if (bytes < 16) throw Bad{what + " is shorter than a blosc header"};
+  r.skip(4, what);
+  const uint32_t full = r.read<uint32_t>(what);
+  r.skip(4, what);
+  const uint32_t packed = r.read<uint32_t>(what);
+  if (full < expect || packed > bytes)
+    throw Bad{what + " has a blosc header for " + std::to_string(full) + " bytes in " +
+              std::to_string(packed) + " where " + std::to_string(expect) + " bytes in " +
+              std::to_string(bytes) + " belong"};
+  r.skip(bytes - 16, what);
+}
+
+// The value of OpenVDB's "__delayedload" metadata (io/DelayedLoadMetadata.cc, readValue): a
+// count, then a mask of `count` bytes and `count` compressed sizes of 8 bytes, each raw or as a
+// blosc chunk of a stated size. OpenVDB reads these by their own sizes, not the stated one, and
+// allocates `count` entries.
+void check_delayed_load(Reader& r, uint32_t size, const std::string& entry) {
+  if (size == 0) return;
+  const uint64_t start = r.pos();
+  const uint32_t count = r.read<uint32_t>(entry + " count");
+  if (count > r.size() / 64)  // one entry per leaf node, and a leaf takes 64 bytes or more
+    throw Bad{entry + " claims " + std::to_string(count) + " leaf nodes, more than the file holds"};
+  for (const uint64_t item : {uint64_t(1), uint64_t(8)}) {
+    const uint32_t bytes = r.read<uint32_t>(entry + " chunk size");
+    if (item == 8 && bytes == UINT32_MAX) break;  // no compressed sizes
+    if (bytes > 0)
+      check_blosc(r, bytes, count * item, entry + " chunk");
+    else
+      r.skip(count * item, entry + " values");
+  }
+  const uint64_t used = r.pos() - start;
+  if (used > size)
+    throw Bad{entry + " holds " + std::to_string(used) + " bytes but claims " + std::to_string(size)};
+  r.skip(size - used, entry + " value");
+}
+
 // A metadata map: count, then (name, type name, size, value) per entry.
 void check_metadata(Reader& r, const std::string& where) {
   const int32_t count = r.read<int32_t>(where + " metadata count");
@@ -108,6 +148,8 @@ void check_metadata(Reader& r, const std::string& where) {
     if (type == "bool") {  // read into a C++ bool: any byte but 0 or 1 is undefined behaviour
       if (static_cast<unsigned char>(r.read<char>(entry + " value")) > 1)
         throw Bad{entry + " is a bool but is neither 0 nor 1"};
+    } else if (type == "__delayedload") {
+      check_delayed_load(r, size, entry);
     } else {
       r.skip(size, entry + " value");
     }
@@ -241,17 +283,8 @@ class FloatTreeCheck {
       r.skip(raw, what);
       return;
     }
-    if (compression & kBlosc) {  // blosc header: uncompressed size at 4, compressed size at 12
-      if (n < 16) throw Bad{what + " is shorter than a blosc header"};
-      r.skip(4, what);
-      const uint32_t full = r.read<uint32_t>(what);
-      r.skip(4, what);
-      const uint32_t packed = r.read<uint32_t>(what);
-      if (full < bytes || packed > static_cast<uint64_t>(n))
-        throw Bad{what + " has a blosc header for " + std::to_string(full) + " bytes in " +
-                  std::to_string(packed) + " where the node has " + std::to_string(bytes) +
-                  " bytes in " + std::to_string(n)};
-      r.skip(static_cast<uint64_t>(n) - 16, what);
+    if (compression & kBlosc) {
+      check_blosc(r, static_cast<uint64_t>(n), bytes, what);
       return;
     }
     r.skip(static_cast<uint64_t>(n), what);  // zlib bounds its output itself

@@ -75,8 +75,9 @@ std::string patched(const fs::path& dir, size_t at, const std::string& bytes) {
 
 // Was (found by fuzz/fuzz_vdb.cpp): a metadata type name changed from "vec3i" to "int32" kept
 // its stated size of 12 bytes; OpenVDB reads 4 and takes the next string's length from the
-// values left over, allocating and filling 1.7 GB twice for a 10 KB file.
-// fuzz/regressions/vdb/metadata-type-size.vdb is the fuzzer's input.
+// values left over, allocating and filling 1.7 GB twice for a 10 KB file. The same through the
+// "__delayedload" metadata, which OpenVDB reads by its inner sizes (1.6 GB twice).
+// fuzz/regressions/vdb/metadata-type-size.vdb and delayed-load-size.vdb are the fuzzer's inputs.
 TEST_CASE("a metadata value whose stated size differs from its type's is refused", "[robust]") {
   test::TempDir tmp("femto_bad_vdb");
   // cloud.vdb: grid metadata 'file_bbox_max' of type vec3i at 0xba, 'file_mem_bytes' (int64) at 0x42b.
@@ -86,6 +87,15 @@ TEST_CASE("a metadata value whose stated size differs from its type's is refused
              Contains("of type int32 claims 8 bytes; the type has 4"));
   CHECK_THAT(load_error(patched(tmp.dir, 0xba, "int32")),
              Contains("patched.vdb: corrupt or unsupported OpenVDB file: grid 1 metadata entry 2"));
+  // OpenVDB reads its "__delayedload" metadata (0x149: size 699, leaf count 180 at 0x15a, then a
+  // 35-byte blosc chunk) by the sizes inside it, not by the stated size.
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x15a, std::string("\xff\xff\xff\x7f", 4))),
+             Contains("claims 2147483647 leaf nodes, more than the file holds"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x156, std::string("\x10\x00\x00\x00", 4))),
+             Contains("holds") && Contains("bytes but claims 16"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x15e, std::string("\xff\x00\x00\x00", 4))),
+             Contains("blosc header for 180 bytes in 35 where 180 bytes in 255 belong") ||
+                 Contains("remain"));
   // The transform's map type name (length at 0x482, "UniformScaleTranslateMap") is read into a
   // string of the stated length: bounded like every other string, and inside the grid.
   CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x482, std::string("\xff\xff\xff\x7f", 4))),
@@ -136,7 +146,7 @@ TEST_CASE("value chunks must have the size of their node", "[robust]") {
              Contains("holds 9223372036854775808 uncompressed bytes"));
   CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd, int64(int64_t(1) << 40))), Contains("remain"));
   CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd + 12, int32(100))),
-             Contains("blosc header for 100 bytes in 196 where the node has 180 bytes in 196"));
+             Contains("blosc header for 100 bytes in 196 where 180 bytes in 196 belong"));
   // A leaf's value mask in the buffers must repeat the one in the tree.
   CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x567c, 0x01)), Contains("differs from the tree's"));
 }
