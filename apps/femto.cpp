@@ -1,6 +1,5 @@
 // The femto command: dispatches to subcommands and maps errors to exit codes
 // (2: bad input, 1: other failures).
-#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -9,22 +8,6 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "femto_version.h"
-
-namespace femto {
-
-std::vector<Command>& commands() {
-  static std::vector<Command> list;
-  return list;
-}
-
-CommandRegistrar::CommandRegistrar(const char* name, const char* summary, CommandFn fn) {
-  auto& list = commands();
-  list.push_back({name, summary, fn});
-  std::sort(list.begin(), list.end(),
-            [](const Command& a, const Command& b) { return std::string(a.name) < b.name; });
-}
-
-}  // namespace femto
 
 namespace {
 void print_usage() {

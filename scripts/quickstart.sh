@@ -1,22 +1,27 @@
 #!/usr/bin/env bash
-# femto quick start: installs what is missing (Debian 12), builds Release, then either renders the
-# built-in default scene (`demo`) or runs the whole test suite (`test`).
-#   scripts/quickstart.sh demo    # build + render the default scene into ./femto-out
-#   scripts/quickstart.sh test    # build + run all tests (ctest)
+# femto quick start: installs what is missing (Debian 12), builds, then renders or tests.
+#   scripts/quickstart.sh demo      # Release build + render the default scene into ./femto-out
+#   scripts/quickstart.sh test      # Release build + run all tests (ctest)
+#   scripts/quickstart.sh sanitize  # clang build with ASan and UBSan (build-asan) + all tests
+#   scripts/quickstart.sh deps      # only install what is missing (also clang for the two above)
 set -euo pipefail
 
 mode="${1:-demo}"
 case "$mode" in
-  demo|test) ;;
-  *) echo "usage: $0 [demo|test]" >&2; exit 2 ;;
+  demo|test|sanitize|deps) ;;
+  *) echo "usage: $0 [demo|test|sanitize|deps]" >&2; exit 2 ;;
 esac
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${FEMTO_BUILD_DIR:-$root/build}"
 jobs="${FEMTO_JOBS:-$(nproc 2>/dev/null || echo 2)}"
 
 packages=(cmake g++ ninja-build libopenvdb-dev libembree-dev libtbb-dev libopenexr-dev catch2
           libboost-iostreams-dev nlohmann-json3-dev libpng-dev python3-numpy)
+# The sanitizer build and the fuzz targets (scripts/fuzz.sh): clang, its sanitizer and libFuzzer
+# runtimes, and llvm-symbolizer for readable reports.
+if [ "$mode" = sanitize ] || [ "$mode" = deps ]; then
+  packages+=(clang libclang-rt-14-dev llvm-14)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -29,7 +34,21 @@ if [ "${#missing[@]}" -gt 0 ]; then
   "${sudo_cmd[@]}" apt-get update -qq
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+[ "$mode" = deps ] && exit 0
 
+if [ "$mode" = sanitize ]; then
+  # -O1: the instrumented suite runs a few times slower than Release; -O1 compiles faster than
+  # -O2 and keeps reports readable. Assertions stay on (no NDEBUG).
+  build="${FEMTO_BUILD_DIR:-$root/build-asan}"
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+        -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DFEMTO_SANITIZE=ON
+  cmake --build "$build" -j "$jobs"
+  cd "$build"
+  ctest --output-on-failure -j "$jobs"  # ASAN_OPTIONS and UBSAN_OPTIONS: set per test by CMake
+  exit 0
+fi
+
+build="${FEMTO_BUILD_DIR:-$root/build}"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build "$build" -j "$jobs"
 

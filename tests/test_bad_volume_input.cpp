@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <climits>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -61,7 +62,104 @@ std::string damaged(const fs::path& dir, size_t at, unsigned mask) {
   return path;
 }
 
+// cloud.vdb with `bytes` written over it at `at`.
+std::string patched(const fs::path& dir, size_t at, const std::string& bytes) {
+  std::string data = test::read_file(example_volume());
+  data.replace(at, bytes.size(), bytes);
+  const std::string path = (dir / "patched.vdb").string();
+  test::write_file(path, data);
+  return path;
+}
+
 }  // namespace
+
+// Was (found by fuzz/fuzz_vdb.cpp): a metadata type name changed from "vec3i" to "int32" kept
+// its stated size of 12 bytes; OpenVDB reads 4 and takes the next string's length from the
+// values left over, allocating and filling 1.7 GB twice for a 10 KB file. The same through the
+// "__delayedload" metadata, which OpenVDB reads by its inner sizes (1.6 GB twice).
+// fuzz/regressions/vdb/metadata-type-size.vdb and delayed-load-size.vdb are the fuzzer's inputs.
+TEST_CASE("a metadata value whose stated size differs from its type's is refused", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  // cloud.vdb: grid metadata 'file_bbox_max' of type vec3i at 0xba, 'file_mem_bytes' (int64) at 0x42b.
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0xba, "int32")),
+             Contains("of type int32 claims 12 bytes; the type has 4"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x42b, "int32")),
+             Contains("of type int32 claims 8 bytes; the type has 4"));
+  CHECK_THAT(load_error(patched(tmp.dir, 0xba, "int32")),
+             Contains("patched.vdb: corrupt or unsupported OpenVDB file: grid 1 metadata entry 2"));
+  // OpenVDB reads its "__delayedload" metadata (0x149: size 699, leaf count 180 at 0x15a, then a
+  // 35-byte blosc chunk) by the sizes inside it, not by the stated size.
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x15a, std::string("\xff\xff\xff\x7f", 4))),
+             Contains("claims 2147483647 leaf nodes, more than the file holds"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x156, std::string("\x10\x00\x00\x00", 4))),
+             Contains("holds") && Contains("bytes but claims 16"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x15e, std::string("\xff\x00\x00\x00", 4))),
+             Contains("blosc header for 180 bytes in 35 where 180 bytes in 255 belong") ||
+                 Contains("remain"));
+  // The transform's map type name (length at 0x482, "UniformScaleTranslateMap") is read into a
+  // string of the stated length: bounded like every other string, and inside the grid.
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x482, std::string("\xff\xff\xff\x7f", 4))),
+             Contains("grid 1 transform type claims 2147483647 bytes, above the 1 MiB limit"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x482, std::string("\x00\x00\x0f\x00", 4))),
+             Contains("grid 1 transform type claims 983040 bytes") && Contains("remain"));
+}
+
+// Was (found by fuzz/fuzz_vdb.cpp): a root tile's active flag of 2 read into a C++ bool inside
+// OpenVDB's RootNode::readTopology (undefined behaviour, reported by UBSan); and a stated child
+// count of 2^32 - 1 made OpenVDB allocate a 270 KB node per child, reading past the end of the
+// file. fuzz/regressions/vdb/root-tile-flag.vdb is the fuzzer's input.
+TEST_CASE("the root node's tiles and children must fit the grid's topology", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  // cloud.vdb: the density tree starts at 0x52e (buffer count 1, background 0, 0 tiles at
+  // 0x536, 1 child at 0x53a, then the child's origin and masks).
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x53a, std::string("\xff\xff\xff\xff", 4))),
+             Contains("grid 1 root claims 0 tiles and 4294967295 children, more than the"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x536, std::string("\xff\xff\xff\x0f", 4))),
+             Contains("grid 1 root claims 268435455 tiles and 1 children"));
+  // One tile (origin, value, flag at 0x54e) in front of the child.
+  std::string tile_flag_2(0x54f - 0x536, '\0');
+  tile_flag_2[0] = '\x01';
+  tile_flag_2.back() = '\x02';
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x536, tile_flag_2)),
+             Contains("grid 1 root tile 1 has an active flag that is neither 0 nor 1"));
+  // Transform types are known ones with their own sizes.
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x486, "UniformScaleTranslateMaq")),
+             Contains("grid 1 has an unknown transform type 'UniformScaleTranslateMaq'"));
+}
+
+// Was (found by fuzz/fuzz_vdb.cpp, reported by ASan): a heap buffer overflow inside OpenVDB 10,
+// which reads a chunk stored uncompressed (a negative size) into the node's buffer before
+// comparing its size with the buffer's. The structure check now walks every node of a float
+// tree and checks each chunk against the size its node gives it.
+// fuzz/regressions/vdb/chunk-overflow.vdb is the fuzzer's input.
+TEST_CASE("value chunks must have the size of their node", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  // cloud.vdb (active-mask and blosc compression): the first leaf's buffers start at 0x567c
+  // (value mask with 45 voxels on, flags 0), its chunk at 0x56bd: 196 bytes of blosc holding 180.
+  const auto int64 = [](int64_t v) { return std::string(reinterpret_cast<const char*>(&v), 8); };
+  const auto int32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd, int64(-4096))),
+             Contains("holds 4096 uncompressed bytes where the node has 180"));
+  CHECK_THAT(load_error(patched(tmp.dir, 0x56bd, int64(-4096))),
+             Contains("patched.vdb: corrupt or unsupported OpenVDB file: grid 1 value chunk at offset 22205"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd, int64(INT64_MIN))),
+             Contains("holds 9223372036854775808 uncompressed bytes"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd, int64(int64_t(1) << 40))), Contains("remain"));
+  CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd + 12, int32(100))),
+             Contains("blosc header for 100 bytes in 196 where 180 bytes in 196 belong"));
+  // A leaf's value mask in the buffers must repeat the one in the tree.
+  CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x567c, 0x01)), Contains("differs from the tree's"));
+}
+
+// Was (found by fuzz/fuzz_vdb.cpp): with the grid-offsets flag cleared, OpenVDB reads the file
+// as a stream, grid after grid, and the structure check (which locates grids by their offsets)
+// did not look past the header: a corrupt metadata size then asked for 2.7 GB.
+// fuzz/regressions/vdb/no-grid-offsets.vdb is the fuzzer's input.
+TEST_CASE("files without grid offsets are refused", "[robust]") {
+  test::TempDir tmp("femto_bad_vdb");
+  CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x14, 0x01)),
+             Contains("no grid offsets (it was written as an OpenVDB stream)"));
+}
 
 // Was: SIGSEGV: the box size x_max - x_min + 1 overflowed int to 0 cells, densify wrote via null.
 TEST_CASE("voxels at INT_MIN and INT_MAX are refused by 64-bit box arithmetic", "[robust]") {
@@ -85,11 +183,12 @@ TEST_CASE("far-apart voxels are refused before the dense box is allocated", "[ro
   CHECK_THAT(load_error(mid, 64ull << 20), Contains("left by --max-memory"));
 }
 
-// Was: std::bad_alloc from OpenVDB's reader, exit 1 without naming the file.
+// Was: std::bad_alloc from OpenVDB's reader, exit 1 without naming the file. Since the
+// structure check walks the tree's chunks, the bad size is found before OpenVDB reads it.
 TEST_CASE("a corrupt size inside the grid data is bad input naming the file", "[robust]") {
   test::TempDir tmp("femto_bad_vdb");
   CHECK_THAT(load_error(damaged(tmp.dir, 3530, 0x04)),
-             Contains("/media/m/file: ") && Contains("damaged.vdb") && Contains("cannot read the file"));
+             Contains("/media/m/file: ") && Contains("damaged.vdb") && Contains("corrupt or unsupported OpenVDB file"));
 }
 
 // Was: OpenVDB trusting lengths in the header and metadata (gigabyte allocations, reads past

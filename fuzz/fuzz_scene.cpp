@@ -1,0 +1,28 @@
+// libFuzzer target: the scene loader (load_scene_string) on arbitrary text.
+// Bad input must be an InputError; any other exception, a crash, a hang or a sanitizer report is
+// a finding. Mesh and volume paths resolve against data/scenes, so the seeds' "../meshes/..."
+// and "../volumes/..." references exist (volumes are only checked for existence here).
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string>
+
+#include "core/error.h"
+#include "core/scene_loader.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try {
+    const femto::SceneDesc scene =
+        femto::load_scene_string(text, "fuzz.json", FEMTO_SOURCE_DIR "/data/scenes");
+    (void)scene;
+  } catch (const femto::InputError&) {
+    // expected for bad input
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fuzz_scene: bad input escaped as %s, not InputError\n", e.what());
+    std::abort();
+  }
+  return 0;
+}
