@@ -97,7 +97,7 @@ TEST_CASE("segment connections match the single-scattering answer bin by bin", "
 // time-uniform + MIS distance sampler (shared r_aux), unwarped camera segments, and a
 // heterogeneous voxel medium with varying index. Reference: collision NEE + phase sampling.
 TEST_CASE("time-targeted sampling agrees with the reference estimator with multiple scattering",
-          "[time-sampling]") {
+          "[time-sampling][statistical]") {
   TempDir tmp("femto_time_sampling");
   // A heterogeneous voxel medium with a varying index of refraction.
   const int n = 16;

@@ -70,6 +70,7 @@ void Sha256::block(const uint8_t* p) {
 }
 
 void Sha256::update(const void* data, size_t bytes) {
+  if (bytes == 0) return;  // data may be null for an empty buffer (memcpy must not see it)
   const auto* p = static_cast<const uint8_t*>(data);
   length_ += bytes;
   if (used_ > 0) {
