@@ -87,9 +87,10 @@ SceneDesc caustic_scene(const TimeAxis& axis) {
 TEST_CASE("light tracing agrees with camera paths: fog with a point light and diffuse walls",
           "[light-paths][statistical]") {
   // The fog fills a box (kept clear of the walls: coincident faces are ambiguous) that leaves out
-  // the camera: a camera inside a medium gives light tracing infinite variance (1 / d^2 connections
-  // from vertices next to the sensor), as a point light does for collision next-event estimation
-  // (hence segment connections here).
+  // the camera and the light: a camera inside a medium gives light tracing infinite variance
+  // (1 / d^2 connections from vertices next to the sensor), and a point light inside one gives
+  // camera paths heavy tails (batches mostly low, seen over seed sweeps), so the batch standard
+  // errors would not be trustworthy.
   const SceneDesc d = load_scene_string(R"({
     "camera": { "type": "perspective", "position": [0, 30, 140], "look_at": [0, 25, 0], "fov": 45,
                 "resolution": [16, 12] },
@@ -97,13 +98,13 @@ TEST_CASE("light tracing agrees with camera paths: fog with a point light and di
     "media": { "fog": { "type": "homogeneous", "sigma_a": 0.004, "sigma_s": 0.02, "g": 0.4, "eta": 1.33,
                         "connection_sampling": "mis" } },
     "shapes": [
-      { "type": "box", "min": [-59, 1, -59], "max": [59, 80, 59], "medium": "fog" },
+      { "type": "box", "min": [-59, 1, -59], "max": [59, 60, 59], "medium": "fog" },
       { "type": "quad", "corner": [-60, 0, 60], "edge1": [120, 0, 0], "edge2": [0, 0, -120],
         "material": { "type": "diffuse", "albedo": 0.7 } },
       { "type": "quad", "corner": [-60, 0, -60], "edge1": [120, 0, 0], "edge2": [0, 80, 0],
         "material": { "type": "diffuse", "albedo": 0.5 } }
     ],
-    "lights": [ { "type": "point", "position": [10, 40, -10], "intensity": 1000 } ]
+    "lights": [ { "type": "point", "position": [10, 75, -10], "intensity": 2000 } ]
   })",
                                         "fog box", ".");
   const Scene scene(d);
