@@ -1,0 +1,30 @@
+#pragma once
+// What `femto render` records about a run: the render.json pieces built from the settings and the
+// result, and the fingerprint a checkpoint must match to be resumed.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/render.h"
+
+namespace femto {
+
+nlohmann::json rgb_json(const RGB& c);
+/// The scene as parsed (scene files may hold // comments), or its text if it cannot be parsed
+/// again: render.json must stay valid JSON.
+nlohmann::json scene_json(const std::string& text);
+/// Where max_depth came from: a chosen bound ends paths on purpose, the default is a safety bound.
+std::string max_depth_source(bool flag, const IntegratorDesc& d);
+/// "a, b, c".
+std::string file_list(const std::vector<std::string>& files);
+nlohmann::json reconstruction_json(const ReconstructionDesc& r, const RenderResult& result);
+/// settings.integrator: which integrator ran, why, and its settings as used.
+nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
+                               const RenderOptions& opt, const RenderResult& result);
+const char* sampling_name(DistanceSampling s);
+/// Everything that decides the bits of a render, for checkpoints: a resume must match it.
+nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc& desc,
+                                  IntegratorKind kind, const RenderOptions& opt);
+
+}  // namespace femto
