@@ -124,6 +124,40 @@ TEST_CASE("the beam estimate's bias shrinks as passes go on", "[beams][statistic
   CHECK(std::abs(bias_prog) < 0.6 * std::abs(bias_fixed));
 }
 
+// Catches: a progressive beam estimate that does not converge to the path-traced answer in
+// time-resolved cells (a radius or bandwidth that stops shrinking, a bias in time that stays, a
+// variance that grows faster than the passes average it away): the mean squared error of one
+// render against a converged camera-path reference, over 2 x 2-pixel cells and every time bin,
+// must fall from 2 to 8 to 32 passes by more than its own uncertainty (4 standard errors).
+// With the radius held fixed (alpha = 1) the error stalls at the kernel's bias and this fails.
+TEST_CASE("beam renders converge to the camera-path answer bin by bin as passes go on",
+          "[beams][statistical]") {
+  const Scene scene(fog_box(16, 12));
+  const auto ref = cells(batches(scene, IntegratorKind::Path, 512, 16, 1300), 2, 1);
+  PhotonDesc pd;
+  pd.per_pass = 2000;
+  pd.radius = 10.0;  // wide at first (visible blur near the light), shrinking by the schedule
+  pd.bandwidth_ps = 40.0;
+  std::vector<MeanSE> mse;
+  for (int passes : {2, 8, 32}) {
+    const auto bm = cells(batches(scene, IntegratorKind::Beams, passes, 12, 1400, pd), 2, 1);
+    // Per render: the sum over cells of the squared error against the reference's mean, less
+    // the reference's own variance (so that a finite reference does not floor the error).
+    std::vector<double> err(bm.front().size(), 0.0);
+    for (size_t c = 0; c < bm.size(); ++c) {
+      const MeanSE r = mean_se(ref[c]);
+      for (size_t k = 0; k < err.size(); ++k)
+        err[k] += (bm[c][k] - r.mean) * (bm[c][k] - r.mean) - r.se * r.se;
+    }
+    mse.push_back(mean_se(err));
+  }
+  INFO("MSE at 2, 8, 32 passes: " << mse[0].mean << " +- " << mse[0].se << ", " << mse[1].mean
+                                  << " +- " << mse[1].se << ", " << mse[2].mean << " +- "
+                                  << mse[2].se);
+  CHECK(mse[0].mean - mse[1].mean > 4.0 * std::hypot(mse[0].se, mse[1].se));
+  CHECK(mse[1].mean - mse[2].mean > 4.0 * std::hypot(mse[1].se, mse[2].se));
+}
+
 // Catches: beam order (and so the tree and the sums) depending on how work is split.
 TEST_CASE("photon beams are bit-identical for 1 and 2 threads", "[beams]") {
   const Scene scene(fog_box(12, 10));

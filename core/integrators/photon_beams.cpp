@@ -21,93 +21,111 @@ constexpr int64_t kChunk = 256;  // light paths per task: the unit of determinis
 constexpr uint64_t kBeamStream = 0x6000000000000000ULL;
 constexpr uint32_t kLeafSize = 4;
 
-double axis_of(const Vec3& v, int a) {
-  return a == 0 ? v.x : (a == 1 ? v.y : v.z);
+}  // namespace
+
+namespace {
+/// A float box that surely holds the double interval [lo, hi] (padded against the rounding of
+/// the float slab test).
+void outward(double lo, double hi, float& flo, float& fhi) {
+  const double pad = 1e-5 * (std::fabs(lo) + std::fabs(hi) + 1.0);
+  flo = std::nextafter(static_cast<float>(lo - pad), -std::numeric_limits<float>::infinity());
+  fhi = std::nextafter(static_cast<float>(hi + pad), std::numeric_limits<float>::infinity());
 }
+
+struct BuildItem {
+  float lo[3], hi[3];
+  float centre[3];
+};
 }  // namespace
 
 void BeamBvh::build(std::vector<Beam> beams, double radius) {
   beams_ = std::move(beams);
+  pieces_.clear();
   nodes_.clear();
   if (beams_.empty()) return;
-  std::vector<Vec3> lo(beams_.size()), hi(beams_.size()), centre(beams_.size());
-  const Vec3 r(radius);
+  std::vector<BuildItem> items;
   for (size_t i = 0; i < beams_.size(); ++i) {
-    const Vec3 a = beams_[i].o, b = beams_[i].o + beams_[i].d * beams_[i].length;
-    lo[i] = vmin(a, b) - r;
-    hi[i] = vmax(a, b) + r;
-    centre[i] = (a + b) * 0.5;
+    const Beam& b = beams_[i];
+    const double want = std::ceil(b.length / (4.0 * radius));
+    const auto n = static_cast<uint32_t>(std::clamp(want, 1.0, double{kMaxPieces}));
+    float v_prev = 0.0f;
+    for (uint32_t k = 0; k < n; ++k) {
+      // Shared float ends: piece k's v1 is piece k + 1's v0, so the ranges tile the beam.
+      const float v1 = k + 1 == n ? std::numeric_limits<float>::infinity()
+                                  : static_cast<float>(b.length * (k + 1) / n);
+      const double a_v = v_prev, b_v = k + 1 == n ? b.length : static_cast<double>(v1);
+      const Vec3 a = b.o + b.d * a_v, e = b.o + b.d * b_v;
+      const Vec3 lo = vmin(a, e) - Vec3(radius), hi = vmax(a, e) + Vec3(radius);
+      BuildItem it;
+      outward(lo.x, hi.x, it.lo[0], it.hi[0]);
+      outward(lo.y, hi.y, it.lo[1], it.hi[1]);
+      outward(lo.z, hi.z, it.lo[2], it.hi[2]);
+      for (int c = 0; c < 3; ++c) it.centre[c] = 0.5f * (it.lo[c] + it.hi[c]);
+      pieces_.push_back({static_cast<uint32_t>(i), v_prev, v1});
+      items.push_back(it);
+      v_prev = v1;
+    }
   }
-  nodes_.reserve(2 * beams_.size() / kLeafSize + 1);
-  build_node(0, static_cast<uint32_t>(beams_.size()), lo, hi, centre);
-}
-
-uint32_t BeamBvh::build_node(uint32_t first, uint32_t count, std::vector<Vec3>& lo,
-                             std::vector<Vec3>& hi, std::vector<Vec3>& centre) {
-  const auto index = static_cast<uint32_t>(nodes_.size());
+  // Median splits on the widest axis of the centres, over an index permutation; ties by index
+  // give the same tree on every run.
+  std::vector<uint32_t> order(pieces_.size());
+  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  nodes_.reserve(2 * pieces_.size() / kLeafSize + 2);
+  struct Task {
+    uint32_t first, count, node;
+  };
+  std::vector<Task> todo;
   nodes_.push_back({});
-  Vec3 blo = lo[first], bhi = hi[first], clo = centre[first], chi = centre[first];
-  for (uint32_t i = first + 1; i < first + count; ++i) {
-    blo = vmin(blo, lo[i]);
-    bhi = vmax(bhi, hi[i]);
-    clo = vmin(clo, centre[i]);
-    chi = vmax(chi, centre[i]);
-  }
-  nodes_[index].lo = blo;
-  nodes_[index].hi = bhi;
-  const Vec3 ext = chi - clo;
-  if (count <= kLeafSize || std::fmax(ext.x, std::fmax(ext.y, ext.z)) <= 0) {
-    nodes_[index].first = first;
-    nodes_[index].count = count;
-    return index;
-  }
-  // Median split on the widest axis of the centres; beams and their boxes move together.
-  const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-  std::vector<uint32_t> order(count);
-  for (uint32_t i = 0; i < count; ++i) order[i] = first + i;
-  const uint32_t half = count / 2;
-  std::nth_element(order.begin(), order.begin() + half, order.end(), [&](uint32_t a, uint32_t b) {
-    const double ca = axis_of(centre[a], axis), cb = axis_of(centre[b], axis);
-    return ca < cb || (ca == cb && a < b);  // ties by index: the same tree on every run
-  });
-  std::vector<Beam> b2(count);
-  std::vector<Vec3> l2(count), h2(count), c2(count);
-  for (uint32_t i = 0; i < count; ++i) {
-    b2[i] = beams_[order[i]];
-    l2[i] = lo[order[i]];
-    h2[i] = hi[order[i]];
-    c2[i] = centre[order[i]];
-  }
-  std::copy(b2.begin(), b2.end(), beams_.begin() + first);
-  std::copy(l2.begin(), l2.end(), lo.begin() + first);
-  std::copy(h2.begin(), h2.end(), hi.begin() + first);
-  std::copy(c2.begin(), c2.end(), centre.begin() + first);
-  const uint32_t left = build_node(first, half, lo, hi, centre);
-  const uint32_t right = build_node(first + half, count - half, lo, hi, centre);
-  nodes_[index].left = left;
-  nodes_[index].right = right;
-  return index;
-}
-
-bool BeamBvh::hits(const Node& n, const Vec3& o, const Vec3& inv_d, double t_max) {
-  double t0 = 0.0, t1 = t_max;
-  for (int a = 0; a < 3; ++a) {
-    const double inv = axis_of(inv_d, a), oa = axis_of(o, a);
-    double ta = (axis_of(n.lo, a) - oa) * inv, tb = (axis_of(n.hi, a) - oa) * inv;
-    if (std::isnan(ta) || std::isnan(tb)) {  // ray parallel to the slab, on its boundary
-      if (oa < axis_of(n.lo, a) || oa > axis_of(n.hi, a)) return false;
+  todo.push_back({0, static_cast<uint32_t>(order.size()), 0});
+  while (!todo.empty()) {
+    const Task t = todo.back();
+    todo.pop_back();
+    float blo[3], bhi[3], clo[3], chi[3];
+    for (int c = 0; c < 3; ++c) {
+      blo[c] = clo[c] = std::numeric_limits<float>::infinity();
+      bhi[c] = chi[c] = -std::numeric_limits<float>::infinity();
+    }
+    for (uint32_t i = t.first; i < t.first + t.count; ++i) {
+      const BuildItem& it = items[order[i]];
+      for (int c = 0; c < 3; ++c) {
+        blo[c] = std::min(blo[c], it.lo[c]);
+        bhi[c] = std::max(bhi[c], it.hi[c]);
+        clo[c] = std::min(clo[c], it.centre[c]);
+        chi[c] = std::max(chi[c], it.centre[c]);
+      }
+    }
+    Node& node = nodes_[t.node];
+    for (int c = 0; c < 3; ++c) node.lo[c] = blo[c], node.hi[c] = bhi[c];
+    const float ext[3] = {chi[0] - clo[0], chi[1] - clo[1], chi[2] - clo[2]};
+    const int axis = ext[0] >= ext[1] && ext[0] >= ext[2] ? 0 : (ext[1] >= ext[2] ? 1 : 2);
+    if (t.count <= kLeafSize || !(ext[axis] > 0)) {
+      node.first = t.first;
+      node.count = t.count;
       continue;
     }
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::fmax(t0, ta);
-    t1 = std::fmin(t1, tb);
-    if (t0 > t1) return false;
+    const uint32_t half = t.count / 2;
+    std::nth_element(order.begin() + t.first, order.begin() + t.first + half,
+                     order.begin() + t.first + t.count, [&](uint32_t a, uint32_t b) {
+                       const float ca = items[a].centre[axis], cb = items[b].centre[axis];
+                       return ca < cb || (ca == cb && a < b);
+                     });
+    const auto left = static_cast<uint32_t>(nodes_.size());
+    nodes_.push_back({});
+    const auto right = static_cast<uint32_t>(nodes_.size());
+    nodes_.push_back({});
+    nodes_[t.node].left = left;
+    nodes_[t.node].right = right;
+    todo.push_back({t.first + half, t.count - half, right});
+    todo.push_back({t.first, half, left});
   }
-  return true;
+  std::vector<Piece> sorted(pieces_.size());
+  for (size_t i = 0; i < order.size(); ++i) sorted[i] = pieces_[order[i]];
+  pieces_ = std::move(sorted);
 }
 
 uint64_t BeamBvh::memory_bytes() const {
-  return beams_.capacity() * sizeof(Beam) + nodes_.capacity() * sizeof(Node);
+  return beams_.capacity() * sizeof(Beam) + pieces_.capacity() * sizeof(Piece) +
+         nodes_.capacity() * sizeof(Node);
 }
 
 void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, double t,
@@ -115,7 +133,7 @@ void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, do
   const Medium& med = scene->media()[static_cast<size_t>(m)];
   const double norm = inv_paths / (2.0 * radius);  // 1-D kernel 1 / (2 R)
   const double R2 = radius * radius;
-  bvh->query(ray.o, ray.d, s_max, [&](const Beam& b) {
+  bvh->query(ray.o, ray.d, s_max, [&](const Beam& b, const BeamBvh::Piece& piece) {
     if (b.medium != m) return;
     // Closest approach of the camera line o + tc u and the beam line b.o + vb b.d.
     const Vec3 w0 = ray.o - b.o;
@@ -123,7 +141,8 @@ void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, do
     const double sin2 = 1.0 - cos_ub * cos_ub;
     if (!(sin2 > 1e-12)) return;  // parallel lines meet in a set of measure zero
     const double tc = (cos_ub * db - du) / sin2, vb = (db - cos_ub * du) / sin2;
-    if (!(tc >= 0 && tc < s_max && vb >= 0 && vb < b.length)) return;
+    // The piece that holds the closest approach owns the crossing (pieces tile the beam).
+    if (!(tc >= 0 && tc < s_max && vb >= piece.v0 && vb < piece.v1 && vb < b.length)) return;
     const Vec3 xc = ray.at(tc);
     if (length_squared(xc - (b.o + b.d * vb)) >= R2) return;
     const double sigma_s = med.type == Medium::Type::Grid

@@ -29,27 +29,37 @@ struct Beam {
 };
 
 /// Bounding-volume hierarchy over beams thickened by R, for segment queries; built per pass.
+/// A long beam is cut into pieces of about 4 R (at most kMaxPieces) so that the boxes stay tight
+/// around slanted beams; a crossing belongs to the one piece whose range holds its closest
+/// approach, so no beam is gathered twice.
 class BeamBvh {
  public:
+  /// Pieces per beam at most: bounds the tree's memory whatever the radius.
+  static constexpr uint32_t kMaxPieces = 16;
+  /// One piece of a beam: parameters [v0, v1) along it (the last piece's v1 is +inf).
+  struct Piece {
+    uint32_t beam = 0;
+    float v0 = 0, v1 = 0;
+  };
   /// Beams must be finite (trace_beams clips them where their time passes the window end).
   void build(std::vector<Beam> beams, double radius);
-  /// Calls f(const Beam&) for every beam whose thickened box the segment o + t d, t in [0, t_max),
-  /// meets.
+  /// Calls f(const Beam&, const Piece&) for every beam piece whose thickened box the segment
+  /// o + t d, t in [0, t_max), meets.
   template <class F>
   void query(const Vec3& o, const Vec3& d, double t_max, F&& f) const;
   size_t size() const { return beams_.size(); }
+  size_t pieces() const { return pieces_.size(); }
   uint64_t memory_bytes() const;
 
  private:
   struct Node {
-    Vec3 lo, hi;
-    uint32_t first = 0, count = 0;  ///< leaf: beams [first, first + count); inner: count = 0
-    uint32_t left = 0, right = 0;
+    float lo[3], hi[3];
+    uint32_t first = 0, count = 0;  ///< leaf: pieces [first, first + count); inner: count = 0
+    uint32_t left = 0, right = 0;   ///< inner: children
   };
-  uint32_t build_node(uint32_t first, uint32_t count, std::vector<Vec3>& lo, std::vector<Vec3>& hi,
-                      std::vector<Vec3>& centre);
-  static bool hits(const Node& n, const Vec3& o, const Vec3& inv_d, double t_max);
+  static bool hits(const Node& n, const float o[3], const float inv_d[3], float t_max);
   std::vector<Beam> beams_;
+  std::vector<Piece> pieces_;
   std::vector<Node> nodes_;
 };
 
@@ -81,29 +91,47 @@ std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64
                               int max_depth, double t_cut_ps, PathStats& stats,
                               bool caustic_only = false);
 
-/// Memory of one pass holding `beams` beams: the traced lists and the tree's copy, the build's
-/// boxes and centres, and the nodes (at most one per beam).
+/// Memory of one pass holding `beams` beams: the traced lists and the tree's copy, and at most
+/// kMaxPieces pieces per beam with their build boxes and nodes.
 inline uint64_t beam_pass_bytes(uint64_t beams) {
-  return beams * (3 * sizeof(Beam) + 3 * sizeof(Vec3) + 64);
+  return beams * (3 * sizeof(Beam) + BeamBvh::kMaxPieces * (sizeof(BeamBvh::Piece) + 64));
 }
 
 template <class F>
 void BeamBvh::query(const Vec3& o, const Vec3& d, double t_max, F&& f) const {
   if (nodes_.empty()) return;
-  const Vec3 inv_d(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+  const float of[3] = {static_cast<float>(o.x), static_cast<float>(o.y), static_cast<float>(o.z)};
+  const float inv[3] = {static_cast<float>(1.0 / d.x), static_cast<float>(1.0 / d.y),
+                        static_cast<float>(1.0 / d.z)};
+  const float tf = static_cast<float>(t_max);
   uint32_t stack[64];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& n = nodes_[stack[--top]];
-    if (!hits(n, o, inv_d, t_max)) continue;
+    if (!hits(n, of, inv, tf)) continue;
     if (n.count > 0) {
-      for (uint32_t i = n.first; i < n.first + n.count; ++i) f(beams_[i]);
+      for (uint32_t i = n.first; i < n.first + n.count; ++i)
+        f(beams_[pieces_[i].beam], pieces_[i]);
     } else if (top + 2 <= 64) {
-      stack[top++] = n.left;
       stack[top++] = n.right;
+      stack[top++] = n.left;
     }
   }
+}
+
+inline bool BeamBvh::hits(const Node& n, const float o[3], const float inv_d[3], float t_max) {
+  // Slab test; boxes are padded by a relative epsilon at build time, so float rounding here
+  // cannot drop a beam within R (a ray parallel to a slab gives +-inf or NaN, which the
+  // comparisons below treat as a miss only when the origin is outside that slab).
+  float t0 = 0.0f, t1 = t_max;
+  for (int a = 0; a < 3; ++a) {
+    const float ta = (n.lo[a] - o[a]) * inv_d[a], tb = (n.hi[a] - o[a]) * inv_d[a];
+    const float near = ta < tb ? ta : tb, far = ta < tb ? tb : ta;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+  }
+  return t0 <= t1;
 }
 
 }  // namespace femto
