@@ -83,7 +83,25 @@ void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
 
 }  // namespace
 
+/// A box or sphere that no other shape's bounds touch: a ray starting strictly inside it leaves
+/// through its own surface before meeting anything else, so that hit is found in closed form
+/// (most rays of a medium held by a box or sphere start inside it). Boxes are axis-aligned (the
+/// loader's make_box); prim[axis][side] is the triangle of that face (side 1: the max face).
+struct EmptyCell {
+  int shape = -1;
+  bool sphere = false;
+  Vec3 lo, hi;  ///< box
+  SphereData sp{};
+  int prim[3][2] = {{-1, -1}, {-1, -1}, {-1, -1}};
+};
+
+constexpr size_t kMaxEmptyCells = 16;  // beyond this the per-ray test would cost more than it saves
+
 struct Geometry::Impl {
+  std::vector<EmptyCell> cells;
+  /// Closed-form closest hit for a ray starting inside an empty cell: 1 hit, 0 no hit in
+  /// (s_min, s_max), -1 not applicable (Embree decides).
+  int inside_hit(const Ray& ray, double s_min, double s_max, SurfaceHit* hit) const;
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::vector<SphereData> spheres;            // indexed by shape (unused for triangle shapes)
@@ -92,7 +110,8 @@ struct Geometry::Impl {
   Vec3 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
 };
 
-Geometry::Geometry(const SceneDesc& desc) : impl_(std::make_unique<Impl>()) {
+Geometry::Geometry(const SceneDesc& desc, bool closed_form_cells)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.device = rtcNewDevice(nullptr);  // no "threads=N": Embree would cap all of TBB with it
   if (!m.device) throw RuntimeError("Embree: cannot create a device");
@@ -149,6 +168,115 @@ Geometry::Geometry(const SceneDesc& desc) : impl_(std::make_unique<Impl>()) {
     m.lo = Vec3(-0.5);
     m.hi = Vec3(0.5);
   }
+  if (closed_form_cells) find_empty_cells(desc);
+}
+
+void Geometry::find_empty_cells(const SceneDesc& desc) {
+  Impl& m = *impl_;
+  const size_t n = desc.shapes.size();
+  std::vector<Vec3> lo(n), hi(n);
+  for (size_t i = 0; i < n; ++i) {
+    const ShapeDesc& sh = desc.shapes[i];
+    if (sh.type == ShapeDesc::Type::Sphere) {
+      lo[i] = sh.center - Vec3(sh.radius);
+      hi[i] = sh.center + Vec3(sh.radius);
+    } else {
+      lo[i] = Vec3(std::numeric_limits<double>::infinity());
+      hi[i] = Vec3(-std::numeric_limits<double>::infinity());
+      for (const Vec3& v : sh.vertices) lo[i] = vmin(lo[i], v), hi[i] = vmax(hi[i], v);
+    }
+  }
+  for (size_t i = 0; i < n && m.cells.size() < kMaxEmptyCells; ++i) {
+    const ShapeDesc& sh = desc.shapes[i];
+    EmptyCell c;
+    c.shape = static_cast<int>(i);
+    if (sh.type == ShapeDesc::Type::Sphere) {
+      c.sphere = true;
+      c.sp = {sh.center, sh.radius};
+    } else if (sh.type == ShapeDesc::Type::Box && sh.vertices.size() == 8 &&
+               sh.triangles.size() == 12) {
+      c.lo = lo[i];
+      c.hi = hi[i];
+      bool aligned = true;  // every corner on the bounds: an axis-aligned box
+      for (const Vec3& v : sh.vertices)
+        aligned = aligned && (v.x == c.lo.x || v.x == c.hi.x) && (v.y == c.lo.y || v.y == c.hi.y) &&
+                  (v.z == c.lo.z || v.z == c.hi.z);
+      const auto& normals = m.tri_normals[i];
+      for (size_t k = 0; k < normals.size() && aligned; ++k) {
+        const Vec3& nk = normals[k];
+        const int axis = std::abs(nk.x) == 1.0 ? 0 : (std::abs(nk.y) == 1.0 ? 1 : 2);
+        const double comp = axis == 0 ? nk.x : (axis == 1 ? nk.y : nk.z);
+        if (std::abs(comp) != 1.0) aligned = false;
+        int& slot = c.prim[axis][comp > 0 ? 1 : 0];
+        if (slot < 0) slot = static_cast<int>(k);
+      }
+      for (int a = 0; a < 3 && aligned; ++a) aligned = c.prim[a][0] >= 0 && c.prim[a][1] >= 0;
+      if (!aligned) continue;
+    } else {
+      continue;
+    }
+    // Empty: no other shape's bounds touch this one's (padded against rounding).
+    const Vec3 clo = lo[i], chi = hi[i];
+    const Vec3 far = vmax(Vec3(std::abs(clo.x), std::abs(clo.y), std::abs(clo.z)),
+                         Vec3(std::abs(chi.x), std::abs(chi.y), std::abs(chi.z)));
+    const double pad = 1e-6 * (length(chi - clo) + length(far));
+    bool empty = true;
+    for (size_t j = 0; j < n && empty; ++j) {
+      if (j == i) continue;
+      const bool apart = lo[j].x > chi.x + pad || hi[j].x < clo.x - pad || lo[j].y > chi.y + pad ||
+                         hi[j].y < clo.y - pad || lo[j].z > chi.z + pad || hi[j].z < clo.z - pad;
+      empty = apart;
+    }
+    if (empty) m.cells.push_back(c);
+  }
+}
+
+int Geometry::Impl::inside_hit(const Ray& ray, double s_min, double s_max,
+                               SurfaceHit* hit) const {
+  for (const EmptyCell& c : cells) {
+    double s;
+    int prim = 0;
+    if (c.sphere) {
+      const Vec3 oc = ray.o - c.sp.center;
+      if (!(dot(oc, oc) < c.sp.radius * c.sp.radius)) continue;
+      const double b = dot(oc, ray.d);
+      const Vec3 perp = oc - ray.d * b;
+      const double disc = c.sp.radius * c.sp.radius - dot(perp, perp);
+      if (!(disc >= 0)) return -1;
+      s = -b + std::sqrt(disc);  // the far root: the origin is inside
+    } else {
+      const Vec3& o = ray.o;
+      if (!(o.x > c.lo.x && o.x < c.hi.x && o.y > c.lo.y && o.y < c.hi.y && o.z > c.lo.z &&
+            o.z < c.hi.z))
+        continue;
+      s = std::numeric_limits<double>::infinity();
+      int axis = -1, side = 0;
+      const double oa[3] = {o.x, o.y, o.z}, da[3] = {ray.d.x, ray.d.y, ray.d.z};
+      const double la[3] = {c.lo.x, c.lo.y, c.lo.z}, ha[3] = {c.hi.x, c.hi.y, c.hi.z};
+      for (int a = 0; a < 3; ++a) {
+        if (da[a] == 0.0) continue;
+        const int sd = da[a] > 0 ? 1 : 0;
+        const double t = ((sd ? ha[a] : la[a]) - oa[a]) / da[a];
+        if (t < s) s = t, axis = a, side = sd;
+      }
+      if (axis < 0) return -1;
+      prim = c.prim[axis][side];
+    }
+    // Inside a cell only its own surface can be met; an exit at or before s_min would need
+    // what lies beyond it.
+    if (!(s > s_min)) return -1;
+    if (!(s < s_max)) return 0;
+    if (hit) {
+      hit->shape = c.shape;
+      hit->prim = prim;
+      hit->s = s;
+      hit->p = ray.at(s);
+      hit->ng = c.sphere ? normalize(hit->p - c.sp.center)
+                         : tri_normals[static_cast<size_t>(c.shape)][static_cast<size_t>(prim)];
+    }
+    return 1;
+  }
+  return -1;
 }
 
 Geometry::~Geometry() {
@@ -162,6 +290,8 @@ Vec3 Geometry::bounds_min() const { return impl_->lo; }
 Vec3 Geometry::bounds_max() const { return impl_->hi; }
 
 bool Geometry::occluded(const Ray& ray, double s_min, double s_max) const {
+  const int fast = impl_->inside_hit(ray, s_min, s_max, nullptr);
+  if (fast >= 0) return fast == 1;
   FemtoContext ctx;
   rtcInitIntersectContext(&ctx.rtc);
   ctx.o = ray.o;
@@ -184,6 +314,8 @@ bool Geometry::occluded(const Ray& ray, double s_min, double s_max) const {
 }
 
 bool Geometry::intersect(const Ray& ray, double s_min, double s_max, SurfaceHit& hit) const {
+  const int fast = impl_->inside_hit(ray, s_min, s_max, &hit);
+  if (fast >= 0) return fast == 1;
   FemtoContext ctx;
   rtcInitIntersectContext(&ctx.rtc);
   ctx.o = ray.o;

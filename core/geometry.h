@@ -18,7 +18,9 @@ struct SurfaceHit {
 
 class Geometry {
  public:
-  explicit Geometry(const SceneDesc& scene);
+  /// closed_form_cells: rays that start inside a box or sphere that nothing else touches find
+  /// their exit in closed form instead of in Embree (false only to test that shortcut).
+  explicit Geometry(const SceneDesc& scene, bool closed_form_cells = true);
   ~Geometry();
   Geometry(const Geometry&) = delete;
   Geometry& operator=(const Geometry&) = delete;
@@ -32,6 +34,7 @@ class Geometry {
   Vec3 bounds_max() const;
 
  private:
+  void find_empty_cells(const SceneDesc& desc);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
