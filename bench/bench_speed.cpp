@@ -51,18 +51,18 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int spp = 64, reps = 8;
+  int spp = 64, reps = 5;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if ((a == "--spp" || a == "--reps") && i + 1 < argc) {
       (a == "--spp" ? spp : reps) = std::atoi(argv[++i]);
     } else {
-      std::fprintf(stderr, "usage: femto-bench-speed [--spp N] [--reps N (seeds, >= 2)]\n");
+      std::fprintf(stderr, "usage: femto-bench-speed [--spp N] [--reps N]\n");
       return 2;
     }
   }
-  if (spp < 1 || reps < 2) {
-    std::fprintf(stderr, "femto-bench-speed: --spp must be positive and --reps at least 2\n");
+  if (spp < 1 || reps < 1) {
+    std::fprintf(stderr, "femto-bench-speed: --spp and --reps must be positive\n");
     return 2;
   }
   const SceneDesc base = load_scene_string(kScene, "<bench fog box>", ".");
@@ -89,14 +89,12 @@ int main(int argc, char** argv) {
     scenes.push_back(std::make_unique<Scene>(d));
   }
   std::printf(
-      "femto-bench-speed: CPU %s; fog box 32 x 32, 150 bins, %d spp, %d seeds per configuration, "
+      "femto-bench-speed: CPU %s; fog box 32 x 32, 150 bins, %d spp, medians of %d runs, "
       "interleaved\n",
       cpu_model().c_str(), spp, reps);
-  // Per configuration: wall times with 1 and 2 threads, and each seed's film (2 threads) for the
-  // per-cell variance across seeds.
+  // Per configuration: wall times with 1 and 2 threads.
   std::vector<std::vector<double>> secs(static_cast<size_t>(2 * n));
   std::vector<PathStats> stats(static_cast<size_t>(n));
-  std::vector<std::vector<std::vector<float>>> films(static_cast<size_t>(n));
   for (int r = 0; r < reps; ++r)
     for (int threads : {1, 2})
       for (int k = 0; k < n; ++k) {
@@ -104,86 +102,21 @@ int main(int argc, char** argv) {
         opt.spp = spp;
         opt.threads = threads;
         opt.quiet = true;
-        opt.seed = 1 + static_cast<uint64_t>(r);
+        opt.seed = 1;
         const RenderResult res = render(*scenes[static_cast<size_t>(k)], opt);
         secs[static_cast<size_t>(2 * k + threads - 1)].push_back(res.wall_seconds);
         stats[static_cast<size_t>(k)] = res.stats;
-        if (threads == 2) {
-          // Cells: pixel x bin, the three channels summed.
-          const TransientFilm& f = res.film;
-          const size_t cells = static_cast<size_t>(f.width() * f.height() * f.bins());
-          std::vector<float> c(cells);
-          for (size_t i = 0; i < cells; ++i)
-            c[i] = f.transient()[3 * i] + f.transient()[3 * i + 1] + f.transient()[3 * i + 2];
-          films[static_cast<size_t>(k)].push_back(std::move(c));
-        }
       }
-  // Error of each configuration against a reference made of all the others (they estimate the
-  // same light; leaving the configuration itself out keeps its error uncorrelated with the
-  // reference). Per cell (pixel x bin): the mean squared error of one seed's film, times the
-  // 1-thread render time; efficiency = that of mfp + collision over that of the configuration.
-  // A squared error, not a variance: an estimator whose rare large values are missed by most
-  // runs shows up as a shortfall in every run.
-  const size_t cells = films[0][0].size();
-  std::vector<std::vector<double>> mean(static_cast<size_t>(n), std::vector<double>(cells, 0.0));
-  for (int k = 0; k < n; ++k)
-    for (const auto& f : films[static_cast<size_t>(k)])
-      for (size_t i = 0; i < cells; ++i) mean[static_cast<size_t>(k)][i] += static_cast<double>(f[i]) / reps;
-  std::vector<double> pooled(cells, 0.0);
-  for (int k = 0; k < n; ++k)
-    for (size_t i = 0; i < cells; ++i) pooled[i] += mean[static_cast<size_t>(k)][i] / n;
-  // Cells with signal: pooled mean above 1% of its 99.9th percentile (a robust peak).
-  std::vector<double> sorted = pooled;
-  std::sort(sorted.begin(), sorted.end());
-  const double peak = sorted[sorted.size() - 1 - sorted.size() / 1000];
-  auto mse_of = [&](int k) {
-    std::vector<double> mse(cells, 0.0);
-    for (size_t i = 0; i < cells; ++i) {
-      const double ref = (pooled[i] * n - mean[static_cast<size_t>(k)][i]) / (n - 1);
-      for (const auto& f : films[static_cast<size_t>(k)])
-        mse[i] += (f[i] - ref) * (f[i] - ref) / reps;
-    }
-    return mse;
-  };
-  const std::vector<double> mse_c = mse_of(n - 1);
-  const double time_c = median(secs[static_cast<size_t>(2 * (n - 1))]);
-  double pooled_total = 0;
-  for (size_t i = 0; i < cells; ++i) pooled_total += pooled[i];
-  std::printf("%-28s %13s %13s %14s %11s  %s\n", "configuration", "paths/s 1 thr",
-              "paths/s 2 thr", "events/s 2 thr", "events/path",
-              "equal-time efficiency vs mfp + collision (median / 1% worst cells), film total");
+  std::printf("%-28s %13s %13s %14s %11s\n", "configuration", "paths/s 1 thr", "paths/s 2 thr",
+              "events/s 2 thr", "events/path");
   for (int k = 0; k < n; ++k) {
     const double paths = static_cast<double>(stats[static_cast<size_t>(k)].paths);
     const double events = static_cast<double>(stats[static_cast<size_t>(k)].medium_events);
     const double t1 = median(secs[static_cast<size_t>(2 * k)]);
     const double t2 = median(secs[static_cast<size_t>(2 * k + 1)]);
-    const std::vector<double> mse = mse_of(k);
-    std::vector<double> eff;
-    for (size_t i = 0; i < cells; ++i)
-      if (pooled[i] > 0.01 * peak && mse[i] > 0 && mse_c[i] > 0)
-        eff.push_back((mse_c[i] * time_c) / (mse[i] * t1));
-    std::sort(eff.begin(), eff.end());
-    const double med = eff.empty() ? 0 : eff[eff.size() / 2];
-    const double worst = eff.empty() ? 0 : eff[eff.size() / 100];
-    // The film total per seed, relative to the pooled total: mean and standard error.
-    std::vector<double> totals;
-    for (const auto& f : films[static_cast<size_t>(k)]) {
-      double sum = 0;
-      for (size_t i = 0; i < cells; ++i) sum += f[i];
-      totals.push_back(sum / pooled_total);
-    }
-    double tm = 0, tv = 0;
-    for (double x : totals) tm += x / reps;
-    for (double x : totals) tv += (x - tm) * (x - tm) / (reps - 1);
-    std::printf("%-28s %13.3g %13.3g %14.3g %11.2f  %6.2fx / %.3fx, total %.3f +- %.3f\n",
-                configs[k].name, paths / t1, paths / t2, events / t2, events / paths, med, worst,
-                tm, std::sqrt(tv / reps));
+    std::printf("%-28s %13.3g %13.3g %14.3g %11.2f\n", configs[k].name, paths / t1, paths / t2,
+                events / t2, events / paths);
   }
-  std::printf(
-      "efficiency: per pixel-bin cell (channels summed; cells above 1%% of the robust peak), mean "
-      "squared error of one render against the mean of all other configurations, times the "
-      "1-thread time; mfp + collision's over the configuration's (> 1: better). 1%% worst: the "
-      "1st percentile over cells. total: the film's sum over the pooled mean's, +- its standard "
-      "error over seeds\n");
+  std::printf("(equal-time errors of these configurations: femto-bench-sampling)\n");
   return 0;
 }
