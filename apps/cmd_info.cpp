@@ -186,6 +186,9 @@ int cmd_info(const std::vector<std::string>& argv, const std::string&) {
       print_vdb(m.vdb, volumes[i]);
     }
     std::printf("    distance sampling: %s\n", sampling(m).c_str());
+    std::printf("    connection sampling: %s, directions: %s\n",
+                connection_sampling_name(m.connection),
+                m.direction == DirectionSampling::Angular ? "angular" : "phase");
   }
   return 0;
 }

@@ -44,11 +44,14 @@ const char* kRenderHelp =
     "  --threads N        worker threads, 0 = all cores (default 0)\n"
     "  --distance-sampling S  collision-distance sampling in every medium, overriding the\n"
     "                     scene: mfp (mean free path), time_uniform (exponential in optical\n"
-    "                     path length, uniform vertex times) or mis (both, combined by MIS)\n"
+    "                     path length, uniform vertex times) or mis (both, combined by MIS);\n"
+    "                     scene default mfp\n"
     "  --connection-sampling C  direct light from point and spot lights along each ray\n"
     "                     segment in every medium: collision (next-event estimation at the\n"
-    "                     collisions), equiangular, line_to_point (uniform in connection time)\n"
-    "                     or mis (line_to_point + equiangular)\n"
+    "                     collisions), equiangular, line_to_point (uniform in connection time),\n"
+    "                     mis (line_to_point + equiangular) or auto (mis on segments that pass\n"
+    "                     close to a light and for spot lights, collision elsewhere; the\n"
+    "                     scene default)\n"
     "  --direction-sampling D   next direction at medium collisions: phase, or angular\n"
     "                     (half phase, half angular sampling uniform in connection time)\n"
     "  --reconstruction R how path contributions become time bins: histogram (one bin per\n"
@@ -160,7 +163,8 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       else if (v == "equiangular") connection = ConnectionSampling::Equiangular;
       else if (v == "line_to_point") connection = ConnectionSampling::LineToPoint;
       else if (v == "mis") connection = ConnectionSampling::Mis;
-      else args.fail("expected collision, equiangular, line_to_point or mis", v);
+      else if (v == "auto") connection = ConnectionSampling::Auto;
+      else args.fail("expected collision, equiangular, line_to_point, mis or auto", v);
     } else if (a == "--direction-sampling") {
       const std::string v = args.value();
       if (v == "phase") direction = DirectionSampling::Phase;
@@ -449,8 +453,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       if (md.sampling != DistanceSampling::Mfp) e["time_uniform_rate_per_mm_opl"] = rm.strategy.lambda;
       if (md.sampling == DistanceSampling::Mis)
         e["mis_heuristic"] = md.mis_heuristic == MisHeuristic::Power ? "power" : "balance";
-      const char* connections[] = {"collision", "equiangular", "line_to_point", "mis"};
-      e["connection_sampling"] = connections[static_cast<int>(md.connection)];
+      e["connection_sampling"] = connection_sampling_name(md.connection);
       e["direction_sampling"] = md.direction == DirectionSampling::Angular ? "angular" : "phase";
       media.push_back(e);
     }

@@ -94,7 +94,8 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
   }
   const MediumDesc& m0 = base.media[0];
   const Config configs[] = {
-      {"default", m0.sampling, m0.connection, true},
+      {"default (mfp + auto)", m0.sampling, m0.connection, true},
+      {"mis + mis", DistanceSampling::Mis, ConnectionSampling::Mis, false},
       {"mfp + equiangular", DistanceSampling::Mfp, ConnectionSampling::Equiangular, false},
       {"mfp + line_to_point", DistanceSampling::Mfp, ConnectionSampling::LineToPoint, false},
       {"mfp + mis", DistanceSampling::Mfp, ConnectionSampling::Mis, false},
@@ -189,10 +190,12 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
     double tm = 0, tv = 0;
     for (double x : totals) tm += x / reps;
     for (double x : totals) tv += (x - tm) * (x - tm) / (reps - 1);
-    std::printf("%s %-27s %10.3g %11.2fx %11.2fx %11.3fx %10.3f +- %.3f\n",
+    char late_text[32] = "           -";  // no late cell with signal
+    if (!late.empty()) std::snprintf(late_text, sizeof(late_text), "%11.2fx", median(late));
+    std::printf("%s %-27s %10.3g %11.2fx %s %11.3fx %10.3f +- %.3f\n",
                 configs[k].is_default ? "*" : " ", configs[k].name,
                 static_cast<double>(stats[static_cast<size_t>(k)].paths) / t, median(all),
-                median(late), sum_mse > 0 ? (sum_mse_c * time_c) / (sum_mse * t) : 0.0, tm,
+                late_text, sum_mse > 0 ? (sum_mse_c * time_c) / (sum_mse * t) : 0.0, tm,
                 std::sqrt(tv / reps));
     std::fflush(stdout);
   }

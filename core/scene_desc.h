@@ -59,8 +59,21 @@ enum class ConnectionSampling {
   Collision,    ///< next-event estimation at the sampled collisions (default)
   Equiangular,  ///< a vertex per segment, uniform in the angle seen from the light (Kulla & Fajardo 2012)
   LineToPoint,  ///< a vertex per segment, uniform in connection time (seed 000 Sec. 5.2)
-  Mis           ///< line-to-point and equiangular, one vertex each, balance heuristic
+  Mis,          ///< line-to-point and equiangular, one vertex each, balance heuristic
+  Auto          ///< Mis on segments that pass close to the light (connection_choice.h), else Collision
 };
+
+/// The scene-file spelling of a connection strategy.
+inline const char* connection_sampling_name(ConnectionSampling c) {
+  switch (c) {
+    case ConnectionSampling::Collision: return "collision";
+    case ConnectionSampling::Equiangular: return "equiangular";
+    case ConnectionSampling::LineToPoint: return "line_to_point";
+    case ConnectionSampling::Mis: return "mis";
+    case ConnectionSampling::Auto: return "auto";
+  }
+  return "?";
+}
 
 /// How the next direction is chosen at a collision in a medium.
 enum class DirectionSampling {

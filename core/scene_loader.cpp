@@ -704,13 +704,14 @@ class Loader {
   void connection_sampling(const Json& o, const std::string& mp, MediumDesc& m) const {
     if (const Json* c = find(o, "connection_sampling")) {
       const std::string v = choice(*c, at(mp, "connection_sampling"),
-                                   {"collision", "equiangular", "line_to_point", "mis"});
+                                   {"collision", "equiangular", "line_to_point", "mis", "auto"});
       m.connection = v == "collision"       ? ConnectionSampling::Collision
                      : v == "equiangular"   ? ConnectionSampling::Equiangular
                      : v == "line_to_point" ? ConnectionSampling::LineToPoint
-                                            : ConnectionSampling::Mis;
+                     : v == "mis"           ? ConnectionSampling::Mis
+                                            : ConnectionSampling::Auto;
     } else {
-      m.connection = ConnectionSampling::Mis;  // the default for scene files (docs/scene-format.md)
+      m.connection = ConnectionSampling::Auto;  // the default for scene files (docs/scene-format.md)
     }
     if (const Json* d = find(o, "direction_sampling"))
       m.direction = choice(*d, at(mp, "direction_sampling"), {"phase", "angular"}) == "phase"
@@ -727,7 +728,7 @@ class Loader {
                    : v == "time_uniform" ? DistanceSampling::TimeUniform
                                          : DistanceSampling::Mis;
     } else {
-      m.sampling = DistanceSampling::Mis;  // the default for scene files (docs/scene-format.md)
+      m.sampling = DistanceSampling::Mfp;  // the default for scene files (docs/scene-format.md)
     }
     const std::string uses =
         std::string("; this medium uses \"") +

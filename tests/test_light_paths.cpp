@@ -178,7 +178,7 @@ TEST_CASE("light tracing agrees with camera paths for a spot light and a laser w
                 "resolution": [16, 12] },
     "time": { "t_start": 300, "bin_width": 80, "bins": 12 },
     "media": { "fog": { "type": "homogeneous", "sigma_a": 0.002, "sigma_s": 0.015, "g": 0.5, "eta": 1.2,
-                        "connection_sampling": "mis" } },
+                        "connection_sampling": "mis", "distance_sampling": "mis" } },
     "shapes": [
       { "type": "box", "min": [-59, 1, -59], "max": [59, 90, 59], "medium": "fog" },
       { "type": "quad", "corner": [-60, 0, 60], "edge1": [120, 0, 0], "edge2": [0, 0, -120],

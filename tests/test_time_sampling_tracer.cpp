@@ -5,9 +5,11 @@
 #include <unistd.h>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "core/integrators/connection_choice.h"
 #include "media/volume_data.h"
 #include "scene_builders.h"
 #include "single_scatter.h"
@@ -19,8 +21,7 @@ using namespace femto::test;
 namespace {
 
 const char* name_of(ConnectionSampling c) {
-  const char* names[] = {"collision", "equiangular", "line_to_point", "mis"};
-  return names[static_cast<int>(c)];
+  return connection_sampling_name(c);
 }
 
 struct BinStats {
@@ -65,17 +66,20 @@ int check_agreement(const BinStats& a, const BinStats& b, const std::string& wha
 
 // Catches: a wrong equiangular or line-to-point pdf in the tracer, a vertex time or
 // transmittance computed from the wrong point, a window that drops reachable vertices, MIS
-// weights that do not sum to one, and point lights estimated twice (segment + collision).
+// weights that do not sum to one, and point lights estimated twice (segment + collision) or by
+// neither (auto: the split between connections and collisions must be exact).
 TEST_CASE("segment connections match the single-scattering answer bin by bin", "[time-sampling]") {
   SingleScatterSetup p;
   p.axis.t_start_ps = 100;
   p.axis.bin_width_ps = 10;
   p.axis.bins = 40;
   for (ConnectionSampling c : {ConnectionSampling::Equiangular, ConnectionSampling::LineToPoint,
-                               ConnectionSampling::Mis}) {
+                               ConnectionSampling::Mis, ConnectionSampling::Auto}) {
     SceneDesc d = p.scene();
     d.media[0].connection = c;
-    const auto films = render_batches(d, 2000, 16, /*max_depth=*/1);
+    // auto leaves far segments to collisions, noisier in late bins: more samples, same resolution.
+    const auto films =
+        render_batches(d, c == ConnectionSampling::Auto ? 4000 : 2000, 16, /*max_depth=*/1);
     int checked = 0;
     for (int i = 0; i < p.axis.bins; ++i) {
       const MeanSE m = bin_mean_se(films, i);
@@ -159,7 +163,8 @@ TEST_CASE("time-targeted sampling agrees with the reference estimator with multi
     d.lights.push_back(point);
 
     const BinStats ref = bin_stats(render_batches(d, 256, 16, /*max_depth=*/8));
-    for (ConnectionSampling c : {ConnectionSampling::LineToPoint, ConnectionSampling::Mis}) {
+    for (ConnectionSampling c :
+         {ConnectionSampling::LineToPoint, ConnectionSampling::Mis, ConnectionSampling::Auto}) {
       for (DirectionSampling dir : {DirectionSampling::Phase, DirectionSampling::Angular}) {
         SceneDesc e = d;
         e.media[0].connection = c;
@@ -171,4 +176,24 @@ TEST_CASE("time-targeted sampling agrees with the reference estimator with multi
       }
     }
   }
+}
+
+// Catches: the auto rule reading the wrong distance (the light's distance from the line when the
+// closest point lies outside the segment, or the segment length instead of the mean free path as
+// the collisions' spread), which would hand near-light segments to collisions (fireflies) or far
+// ones to connections (cost).
+TEST_CASE("auto connects the segments whose light term peaks narrowly", "[time-sampling]") {
+  const Vec3 o(0, 0, 0), d(1, 0, 0);
+  // Foot on the segment: distance from the line against 0.1 x min(length, mean free path).
+  CHECK(connect_segment_to(o, d, 100.0, 0.1, {50, 0.9, 0}));     // 0.9 < 0.1 x 10
+  CHECK_FALSE(connect_segment_to(o, d, 100.0, 0.1, {50, 1.1, 0}));
+  CHECK(connect_segment_to(o, d, 5.0, 0.0001, {2.5, 0.4, 0}));   // short segment: 0.1 x 5
+  CHECK_FALSE(connect_segment_to(o, d, 5.0, 0.0001, {2.5, 0.6, 0}));
+  // Foot behind the start: distance from the start; beyond the end: from the end.
+  CHECK(connect_segment_to(o, d, 100.0, 0.1, {-0.5, 0.5, 0}));   // |(-0.5, 0.5)| = 0.71 < 1
+  CHECK_FALSE(connect_segment_to(o, d, 100.0, 0.1, {-5, 0.1, 0}));
+  CHECK(connect_segment_to(o, d, 20.0, 0.1, {20.5, 0.5, 0}));
+  CHECK_FALSE(connect_segment_to(o, d, 20.0, 0.1, {25, 0.1, 0}));
+  // A clear, endless segment has no collisions to lean on.
+  CHECK(connect_segment_to(o, d, std::numeric_limits<double>::infinity(), 0.0, {1e3, 1e3, 0}));
 }

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/constants.h"
+#include "core/integrators/connection_choice.h"
 #include "core/integrators/volpath.h"
 #include "media/phase_hg.h"
 #include "samplers/angular.h"
@@ -131,6 +132,10 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
   const Light& L = lights.light(li);
   if (!is_point_like(L)) return;  // area lights and lasers: next-event estimation at collisions
   const Vec3& p = L.position;
+  const ConnectionSampling kind = med.connection;
+  if (kind == ConnectionSampling::Auto && L.type != Light::Type::Spot &&
+      !connect_segment_to(ray.o, ray.d, s_surf, spread_sigma_t(med, ray.o), p))
+    return;  // collision next-event estimation's share
   // No vertex whose path passes the cut-off: with eta >= 1 the time of s and its connection is at
   // least (s + d) / c with d >= s - |p - o|; an unwarped camera segment counts only d.
   const double l = length(p - ray.o), budget = kSpeedOfLight * (t_cut_ - t);
@@ -138,9 +143,8 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
   const double s_end = std::min(s_surf, reach);
   if (!(s_end > 0)) return;
 
-  const ConnectionSampling kind = med.connection;
-  const bool use_eq = kind == ConnectionSampling::Equiangular || kind == ConnectionSampling::Mis;
-  const bool use_lp = kind == ConnectionSampling::LineToPoint || kind == ConnectionSampling::Mis;
+  const bool use_eq = kind != ConnectionSampling::LineToPoint;
+  const bool use_lp = kind != ConnectionSampling::Equiangular;
   const EquiangularSampler eq(ray.o, ray.d, p, 0.0, s_end);
   const double eta0 = med.eta_at(ray.o);
   const LineToPointSampler lp(ray.o, ray.d, p, eta0);

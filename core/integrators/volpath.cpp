@@ -1,9 +1,12 @@
 #include "core/integrators/volpath.h"
 
+#include "core/integrators/connection_choice.h"
+
 #include <cmath>
 #include <limits>
 
 #include "core/constants.h"
+#include "core/integrators/connection_choice.h"
 #include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
 #include "core/sampling.h"
@@ -46,9 +49,15 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
   acc.add(filter_, t_ps, sigma_ps, value);
 }
 
+bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
+  if (!active) return false;
+  return all || light.type == Light::Type::Spot ||
+         connect_segment_to(ray.o, ray.d, s_surf, sigma_t, light.position);
+}
+
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
                                                const RGB& beta, double t, const DirectionMix* mix,
-                                               bool skip_point_lights, Rng& rng,
+                                               const ConnectedSegment& segment, Rng& rng,
                                                PixelAccumulator& acc, PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
@@ -56,7 +65,8 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
   const double u1 = rng.uniform(), u2 = rng.uniform();
   LightSample ls;
   if (li < 0 || beta.is_black()) return;
-  if (skip_point_lights && is_point_like(lights.light(li))) return;  // estimate_segment's share
+  if (is_point_like(lights.light(li)) && segment.covers(lights.light(li)))
+    return;  // estimate_segment's share
   if (!lights.sample(li, x, u1, u2, ls)) return;
   const double f = hg_eval(dot(d, ls.wi), g);
   double Tr, dt;
@@ -156,6 +166,14 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
       const bool segment_connections =
           med.connection != ConnectionSampling::Collision && !point_lights_.empty();
+      ConnectedSegment segment;
+      segment.active = segment_connections;
+      segment.all = med.connection != ConnectionSampling::Auto;
+      segment.ray = ray;
+      segment.s_surf = s_surf;
+      segment.sigma_t = segment_connections && !segment.all
+                            ? spread_sigma_t(med, ray.o)
+                            : 0.0;
       if (segment_connections && depth < max_depth_)
         estimate_segment(med, m, ray, s_surf, beta, t, t_dropped, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every
@@ -174,7 +192,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
         const DirectionMix mix2 = angular ? direction_mix(med, x2, t2, u_next) : DirectionMix{};
         estimate_direct_medium(x2, m, ray.d, med.g(),
                                beta * (MediumTracker::albedo_at(med, x2) * ms.extra_nee_weight), t2,
-                               angular ? &mix2 : nullptr, segment_connections, rng, acc, stats);
+                               angular ? &mix2 : nullptr, segment, rng, acc, stats);
       }
       const DistanceEvent& ev = ms.main;
       if (!ev.collided && !found) break;  // escaped to infinity
@@ -197,7 +215,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
         beta *= MediumTracker::albedo_at(med, x);
         if (beta.is_black()) break;
         estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t,
-                               angular ? &mix_main : nullptr, segment_connections, rng, acc, stats);
+                               angular ? &mix_main : nullptr, segment, rng, acc, stats);
         Vec3 wi;
         beta *=
             sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone

@@ -56,12 +56,21 @@ class VolPathIntegrator {
   /// Samples the next direction; returns f / pdf (1 for phase sampling alone) and the pdf.
   double sample_direction(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g, Rng& rng,
                           Vec3& w, double& pdf) const;
+  /// The segment a medium vertex lies on, as far as segment connections are concerned: which
+  /// point and spot lights estimate_segment has already gathered along it.
+  struct ConnectedSegment {
+    bool active = false;  ///< the medium uses segment connections (and there are point lights)
+    bool all = false;     ///< every point light (an explicit strategy), else connection_choice.h
+    Ray ray;
+    double s_surf = 0, sigma_t = 0;
+    bool covers(const Light& light) const;
+  };
   /// Next-event estimation from a medium point x reached along direction d with throughput beta.
   /// `mix` (may be null) gives the direction density for MIS with area lights; point and spot
-  /// lights are left to estimate_segment when the medium uses segment connections.
+  /// lights that `segment` covers are left to estimate_segment.
   void estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g, const RGB& beta,
-                              double t, const DirectionMix* mix, bool skip_point_lights, Rng& rng,
-                              PixelAccumulator& acc, PathStats& stats) const;
+                              double t, const DirectionMix* mix, const ConnectedSegment& segment,
+                              Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
   /// Direct light from a point or spot light scattered anywhere on [0, s_surf) of `ray` in
   /// medium m (equiangular, line-to-point, or both by MIS). t_factor converts optical path
   /// length to time (0 on the camera segment in unwarp mode).
