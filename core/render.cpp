@@ -219,9 +219,12 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
   m.per_thread = static_cast<uint64_t>(std::max(1, threads)) * (B * 3 * sizeof(double) + held);
   if (opt.integrator == IntegratorKind::Photons || opt.integrator == IntegratorKind::Hybrid)
     m.integrator = photon_pass_bytes(opt.photons.per_pass > 0 ? opt.photons.per_pass : 200000);
-  // Beams: an estimate (the beams a light path leaves depend on the scene), about 8 per path.
-  if (opt.integrator == IntegratorKind::Beams)
-    m.integrator = beam_pass_bytes(8 * static_cast<uint64_t>(opt.photons.per_pass > 0 ? opt.photons.per_pass : 20000));
+  // Beams: an estimate (the beams a light path leaves depend on the scene), about 8 per path
+  // for all beams; the hybrid's caustic beams end at the path's first scattering, about 2.
+  if (opt.integrator == IntegratorKind::Beams || opt.integrator == IntegratorKind::Hybrid)
+    m.integrator += beam_pass_bytes(
+        (opt.integrator == IntegratorKind::Beams ? 8 : 2) *
+        static_cast<uint64_t>(opt.photons.per_pass > 0 ? opt.photons.per_pass : 20000));
   if (opt.integrator == IntegratorKind::Light) m.integrator = light_batch_bytes(pixels);
   // Writing: a frame, the peak-time image, the contact sheet's 16 frames and its 8-bit image,
   // the 8-bit preview; a multipart EXR is written from the film itself.
