@@ -128,7 +128,7 @@ std::vector<std::string> write_outputs(const std::string& dir, const Setup& s, c
   write_text_atomically(path("summary.json"), summary.dump(2) + "\n");
   files.push_back("render.json");
   record["tissue_summary"] = summary;
-  record["files"] = files;
+  record["outputs"] = files;  // what an output folder may hold (core/output_folder.h)
   write_text_atomically(dir + "/render.json", record.dump(2) + "\n");
   return files;
 }
