@@ -27,9 +27,10 @@ struct Source {
   double sigma_ps() const { return fwhm_ps / 2.3548200450309493; }
 };
 
-/// A disc detector on the tissue surface: photons leaving the tissue within `radius` of `center`
-/// are detected, if their exit direction lies within the numerical aperture (na > 0; measured in
-/// the outside medium, from the normal of the face they leave through).
+/// A disc detector on the tissue surface: photons leaving the tissue through a voxel face in the
+/// plane of `center` and within `radius` of it are detected, if their exit direction lies within
+/// the numerical aperture (na > 0; in the outside medium, from the normal of the face they leave
+/// through). A photon counts for the first detector (in order) that it reaches.
 struct Detector {
   Vec3 center{0, 0, 0};
   double radius = 1;  ///< mm

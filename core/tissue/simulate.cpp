@@ -75,6 +75,7 @@ class Tally {
     const FluenceGrid& fg = s.fluence_grid;
     h_ = fg.spacing();
     cells_ = fg.cells();
+    plane_tolerance_ = 1e-6 * s.volume.voxel;
   }
   void begin(ChunkSums& out) {
     out_ = &out;
@@ -219,6 +220,8 @@ class Tally {
       const Detector& det = s_.detectors[i];
       const Vec3 r = p.x - det.center;
       if (dot(r, r) > det.radius * det.radius) continue;
+      // The disc lies in the plane of the face the photon leaves through.
+      if (p.face_axis >= 0 && std::abs(r[p.face_axis]) > plane_tolerance_) continue;
       if (det.na > 0 && p.face_axis >= 0) {
         const double cos_out = std::abs(p.d[p.face_axis]);  // exit angle from the face normal
         const double sin_max = det.na / n_out;
@@ -245,6 +248,7 @@ class Tally {
   bool same_grid_;
   Vec3 h_;
   size_t cells_ = 0;
+  double plane_tolerance_ = 0;
   static constexpr size_t kNone = ~size_t{0};
   size_t pending_ = kNone;
   double pending_value_ = 0;
