@@ -419,6 +419,7 @@ Result simulate(const Setup& s) {
     const uint64_t p1 = s.photons * static_cast<uint64_t>(b + 1) / static_cast<uint64_t>(batches);
     const size_t chunks = static_cast<size_t>((p1 - p0 + kChunk - 1) / kChunk);
     std::vector<ChunkSums> chunk(chunks);
+    const auto trace_start = std::chrono::steady_clock::now();
     arena.execute([&] {
       tbb::parallel_for(size_t{0}, chunks, [&](size_t c) {
         ThreadSums& ts = thread_sums.local();
@@ -431,6 +432,7 @@ Result simulate(const Setup& s) {
         progress.add(q1 - q0);
       });
     });
+    r.trace_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - trace_start).count();
     // Chunk order: the reduction does not depend on which thread traced what.
     std::vector<double> batch_tpsf(tpsf_size, 0.0);
     for (ChunkSums& c : chunk) {

@@ -41,7 +41,8 @@ struct Result {
   int gates = 0, labels = 0;  ///< labels: size of the optics table (label 0 included)
   uint64_t photons = 0, scatterings = 0, segments = 0;
   int threads = 0, batches = 0;
-  double seconds = 0;
+  double seconds = 0;        ///< the whole run
+  double trace_seconds = 0;  ///< tracing photons only (no allocation, reductions, results)
   double fixed_point_quantum = 0;  ///< mm per unit of the integer volume sums
   /// Fluence per gate, 1/mm^2, index cell * gates + gate (cell = (i ny + j) nz + k): (X,Y,Z,T).
   std::vector<float> fluence, fluence_err;
