@@ -145,13 +145,6 @@ class Tally {
     int j = std::clamp(static_cast<int>((lo - ax.t_start_ps) / ax.bin_width_ps), 0, gates_ - 1);
     // Gate-major: a photon's consecutive deposits fall in one gate's grid, which stays in cache.
     const size_t stride = cells_;
-    if (hi <= ax.bin_start_ps(j + 1) || j == gates_ - 1) {  // one gate: the common case
-      const double w_len = a == 0 && b == seg.duration && seg.k > 0
-                               ? seg.absorbed / seg.k * seg.v  // no second exponential
-                               : seg.w0 * seg.v * exp_integral(seg.k, lo - seg.t0, hi - seg.t0);
-      add(c + j * stride, w_len);
-      return;
-    }
     for (double t = lo; t < hi && j < gates_; ++j) {
       const double te = j == gates_ - 1 ? hi : std::min(hi, ax.bin_start_ps(j + 1));
       if (te > t) add(c + j * stride, seg.w0 * seg.v * exp_integral(seg.k, t - seg.t0, te - seg.t0));
@@ -159,9 +152,50 @@ class Tally {
     }
   }
 
+  // Integral of exp(-mu s) over a piece of length ds, divided by ds: (1 - e^-x) / x with
+  // x = mu ds, and e^-x itself (a series for small x: no exponential per voxel).
+  static double mean_decay(double x, double& e) {
+    if (x < 0.01) {  // truncation below x^5 / 720 < 1.4e-13
+      const double g = 1 - x * (0.5 - x * (1.0 / 6 - x * (1.0 / 24 - x * (1.0 / 120))));
+      e = 1 - x * g;
+      return g;
+    }
+    e = std::exp(-x);
+    return (1 - e) / x;
+  }
+
   void fluence(const Segment& seg) {
     if (same_grid_) {
-      deposit(seg, s_.volume.index(seg.cell[0], seg.cell[1], seg.cell[2]), 0, seg.duration);
+      // The label grid's voxels along the segment; the weight factor exp(-mu_a s) is carried
+      // from voxel to voxel.
+      const LabelVolume& vol = s_.volume;
+      const TimeAxis& ax = s_.time;
+      const double L = seg.distance, mu = seg.k / seg.v, inv_v = 1.0 / seg.v;
+      const int j0 = ax.bin_of(seg.t0);
+      const bool one_gate = j0 >= 0 && seg.t0 + seg.duration <= ax.bin_start_ps(j0 + 1);
+      const size_t gate_offset = one_gate ? static_cast<size_t>(j0) * cells_ : 0;
+      VoxelDda dda(seg.x0, seg.d, seg.cell, vol.origin, Vec3(vol.voxel));
+      double sa = 0, ea = 1;
+      while (true) {
+        const int a = dda.axis();
+        const bool last = dda.t_max[a] >= L;
+        const double sb = last ? L : dda.t_max[a];
+        if (sb > sa) {
+          const size_t c = vol.index(dda.cell[0], dda.cell[1], dda.cell[2]);
+          if (one_gate) {
+            double e;
+            const double g = mean_decay(mu * (sb - sa), e);
+            add(c + gate_offset, seg.w0 * ea * (sb - sa) * g);
+            ea *= e;
+          } else {  // the segment crosses gates (or the window start): split exactly
+            deposit(seg, c, sa * inv_v, sb * inv_v);
+            ea = mu > 0 ? std::exp(-mu * sb) : 1.0;
+          }
+        }
+        if (last) break;
+        sa = sb;
+        dda.advance(a);
+      }
       return;
     }
     // Walk the fluence grid's cells along the segment (3-D DDA), clipped to its box.
@@ -327,13 +361,19 @@ bool launch(const Setup& s, const LabelSpace& space, Rng& rng, Photon& p, double
     p.cell[a] = std::clamp(clamped_floor((p.x[a] - vol.origin[a]) / vol.voxel), 0, vol.n[a] - 1);
   if (axis >= 0) p.x[axis] = vol.origin[axis] + (p.d[axis] > 0 ? 0 : vol.n[axis]) * vol.voxel;
   // Through label-0 voxels to the first tissue voxel.
-  while (vol.label_at(p.cell[0], p.cell[1], p.cell[2]) == 0) {
-    const double step = space.distance_to_face(p, axis);
-    travelled += step;
-    p.x += p.d * step;
-    p.cell[axis] += p.d[axis] > 0 ? 1 : -1;
+  if (vol.label_at(p.cell[0], p.cell[1], p.cell[2]) == 0) {
+    VoxelDda dda(p.x, p.d, p.cell, vol.origin, Vec3(vol.voxel));
+    double s_entry = 0;
+    while (vol.label_at(dda.cell[0], dda.cell[1], dda.cell[2]) == 0) {
+      axis = dda.axis();
+      s_entry = dda.t_max[axis];
+      dda.advance(axis);
+      if (dda.cell[axis] < 0 || dda.cell[axis] >= vol.n[axis]) return false;
+    }
+    travelled += s_entry;
+    p.x += p.d * s_entry;
+    for (int a = 0; a < 3; ++a) p.cell[a] = dda.cell[a];
     p.x[axis] = vol.origin[axis] + (p.cell[axis] + (p.d[axis] > 0 ? 0 : 1)) * vol.voxel;
-    if (p.cell[axis] < 0 || p.cell[axis] >= vol.n[axis]) return false;
   }
   p.label = vol.label_at(p.cell[0], p.cell[1], p.cell[2]);
   const double n1 = space.optics(0).n, n2 = space.optics(p.label).n;

@@ -22,7 +22,8 @@ struct Photon {
   int face_axis = -1;       ///< axis of the last voxel face crossed or reflected at (tissue walk)
 };
 
-/// A straight piece of a path at constant speed: position x0 + d v tau and weight
+/// A straight piece of a path at constant speed (in the tissue walk: inside one label, across
+/// any number of its voxels): position x0 + d v tau and weight
 /// w0 exp(-k tau) for tau in [0, duration]; duration may be +inf (no further event).
 struct Segment {
   Vec3 x0, d;
@@ -33,9 +34,10 @@ struct Segment {
   double k = 0;         ///< weight decay rate along the segment, 1/ps (weighted absorption)
   double absorbed = 0;  ///< w0 (1 - exp(-k duration)): the energy absorbed along the segment
   int scatterings = 0;  ///< scattering events before this segment (0: unscattered light)
-  int label = 0;        ///< label of the region crossed (tissue walk)
-  int cell[3] = {0, 0, 0};  ///< voxel crossed (tissue walk)
-  double length() const { return v * duration; }
+  double distance = 0;  ///< geometric length, mm (tissue walk; v * duration up to rounding)
+  int label = 0;        ///< label of the region crossed (tissue walk: one label, many voxels)
+  int cell[3] = {0, 0, 0};  ///< voxel of the start (tissue walk)
+  double length() const { return distance; }
 };
 
 /// Integral over tau in [a, b] of exp(-k tau), stable for k b small (k >= 0).

@@ -1,8 +1,7 @@
 #pragma once
 // The photon random walk of tissue optics and of `femto diffusion`, written once: a step moves a
-// photon along one straight piece (to its next scattering, to a face of its voxel where the
-// refractive index may change, or to the window end) and describes that piece as a Segment for
-// the tallies. What the space looks like is a template parameter (an unbounded homogeneous
+// photon along one straight piece (to its next scattering, to a voxel face where the label
+// changes, or to the window end) and describes that piece as a Segment for the tallies. What the space looks like is a template parameter (an unbounded homogeneous
 // medium, or a labelled voxel grid with Fresnel interfaces), so the hot loop has no virtual calls.
 #include <cmath>
 #include <limits>
@@ -48,12 +47,43 @@ struct WalkSettings {
   double t_end = std::numeric_limits<double>::infinity();  ///< window end, ps: photons stop there
 };
 
+/// Regular-grid traversal (3-D DDA, Amanatides & Woo) along x + d s from voxel `cell`: the
+/// distance to the next face on each axis, advanced incrementally (no division per voxel).
+struct VoxelDda {
+  int cell[3] = {0, 0, 0}, step[3] = {0, 0, 0};
+  double t_max[3] = {0, 0, 0}, t_delta[3] = {0, 0, 0};
+
+  VoxelDda(const Vec3& x, const Vec3& d, const int c[3], const Vec3& origin, const Vec3& h) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+      cell[a] = c[a];
+      if (d[a] == 0) {
+        step[a] = 0, t_max[a] = kInf, t_delta[a] = kInf;
+        continue;
+      }
+      step[a] = d[a] > 0 ? 1 : -1;
+      const double face = origin[a] + (c[a] + (d[a] > 0 ? 1 : 0)) * h[a];
+      t_max[a] = std::max(0.0, (face - x[a]) / d[a]);
+      t_delta[a] = h[a] / std::abs(d[a]);
+    }
+  }
+  /// The axis of the nearest face.
+  int axis() const {
+    return t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+  }
+  void advance(int a) {
+    cell[a] += step[a];
+    t_max[a] += t_delta[a];
+  }
+};
+
 /// An unbounded homogeneous medium (femto diffusion): no faces, one label.
 class UnboundedSpace {
  public:
   explicit UnboundedSpace(const TissueOptics& o) : o_(WalkOptics::of(o)) {}
   const WalkOptics& optics(int) const { return o_; }
-  double distance_to_face(const Photon&, int&) const {
+  double distance_to_interface(const Photon& p, double, int&, int end_cell[3]) const {
+    for (int a = 0; a < 3; ++a) end_cell[a] = p.cell[a];
     return std::numeric_limits<double>::infinity();
   }
   StepEvent cross(Photon&, int, Rng&) const { return StepEvent::Face; }  // never reached
@@ -62,10 +92,10 @@ class UnboundedSpace {
   WalkOptics o_;
 };
 
-/// A labelled voxel grid. Where the refractive index changes across a voxel face (between labels,
-/// or into label 0 at the outer surface) the photon is reflected with the Fresnel reflectance of
-/// unpolarised light (total internal reflection included) or refracted by Snell's law, when
-/// `fresnel`; otherwise every face is index-matched (straight through, no reflection).
+/// A labelled voxel grid. Where the label changes across a voxel face (another tissue, or label
+/// 0 at the outer surface) and the refractive index differs, the photon is reflected with the
+/// Fresnel reflectance of unpolarised light (total internal reflection included) or refracted by
+/// Snell's law, when `fresnel`; otherwise every face is index-matched (straight through).
 class LabelSpace {
  public:
   LabelSpace(const LabelVolume& volume, bool fresnel) : vol_(volume), fresnel_(fresnel) {
@@ -74,20 +104,31 @@ class LabelSpace {
   const LabelVolume& volume() const { return vol_; }
   const WalkOptics& optics(int label) const { return optics_[static_cast<size_t>(label)]; }
 
-  /// Distance along p.d to the nearest face of p's voxel; `axis` is that face's axis.
-  double distance_to_face(const Photon& p, int& axis) const {
-    double best = std::numeric_limits<double>::infinity();
-    for (int a = 0; a < 3; ++a) {
-      const double da = p.d[a];
-      if (da == 0) continue;
-      const int face = da > 0 ? p.cell[a] + 1 : p.cell[a];
-      const double s = (vol_.origin[a] + face * vol_.voxel - p.x[a]) / da;
-      if (s < best) best = s, axis = a;
+  /// Distance along p.d to the first voxel face where the label changes, if it comes before
+  /// s_stop (else +inf); `axis` is that face's axis. end_cell: the voxel holding the end of the
+  /// piece (the last voxel before that face, or the voxel at s_stop). Faces between voxels of
+  /// the same label are crossed here, without a step of the walk.
+  double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3]) const {
+    VoxelDda dda(p.x, p.d, p.cell, vol_.origin, Vec3(vol_.voxel));
+    double s = std::numeric_limits<double>::infinity();
+    while (true) {
+      const int a = dda.axis();
+      const double t = dda.t_max[a];
+      if (t >= s_stop) break;
+      int next[3] = {dda.cell[0], dda.cell[1], dda.cell[2]};
+      next[a] += dda.step[a];
+      if (vol_.label_at(next[0], next[1], next[2]) != p.label) {
+        s = t, axis = a;
+        break;
+      }
+      dda.advance(a);
     }
-    return best > 0 ? best : 0.0;
+    end_cell[0] = dda.cell[0], end_cell[1] = dda.cell[1], end_cell[2] = dda.cell[2];
+    return s;
   }
 
-  /// The photon is on the face of its voxel on `axis`: reflect, or move into the neighbour.
+  /// The photon is on the face of its voxel on `axis`, facing another label: reflect, or move
+  /// into the neighbour.
   StepEvent cross(Photon& p, int axis, Rng& rng) const {
     const int step = p.d[axis] > 0 ? 1 : -1;
     p.x[axis] = vol_.origin[axis] + (p.cell[axis] + (step > 0 ? 1 : 0)) * vol_.voxel;  // no drift
@@ -140,16 +181,16 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   const bool analog = ws.absorption == Absorption::Analog;
   const double rate = analog ? o.mu_t : o.mu_s;
   if (p.tau_left < 0) p.tau_left = -std::log(1 - rng.uniform());  // 1 - u is exact
-  int axis = 0;
+  int axis = 0, end_cell[3];
   const double s_event = rate > 0 ? p.tau_left / rate : kInf;
-  const double s_face = space.distance_to_face(p, axis);
   const double s_window = (ws.t_end - p.t) * o.v;
+  const double s_face = space.distance_to_interface(p, std::min(s_event, s_window), axis, end_cell);
   StepEvent ev;
   double s;
-  if (s_event <= s_face && s_event <= s_window) {
-    s = s_event, ev = StepEvent::Scattered;
-  } else if (s_face <= s_window) {
+  if (s_face < s_event && s_face < s_window) {
     s = s_face, ev = StepEvent::Face;
+  } else if (s_event <= s_window) {
+    s = s_event, ev = StepEvent::Scattered;
   } else {
     s = std::max(0.0, s_window), ev = StepEvent::WindowEnd;
   }
@@ -158,6 +199,7 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   seg.scatterings = p.scatterings, seg.label = p.label;
   seg.cell[0] = p.cell[0], seg.cell[1] = p.cell[1], seg.cell[2] = p.cell[2];
   seg.duration = s / o.v;
+  seg.distance = s;
   if (!std::isfinite(s)) {  // an endless flight: everything is absorbed on the way (if mu_a > 0)
     seg.absorbed = seg.k > 0 ? p.w : 0.0;
     p.w -= seg.absorbed;
@@ -169,6 +211,7 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   seg.absorbed = x > 0 ? p.w * one_minus_exp(x) : 0.0;
   p.w -= seg.absorbed;  // absorbed + carried = w0 exactly, up to one rounding
   p.x += p.d * s;
+  p.cell[0] = end_cell[0], p.cell[1] = end_cell[1], p.cell[2] = end_cell[2];
   if (ev == StepEvent::WindowEnd) {
     p.t = ws.t_end;
     p.tau_left -= rate * s;
