@@ -344,3 +344,60 @@ TEST_CASE("femto render runs a tissue scene and writes the documented outputs", 
   CHECK(nv.dim == std::array<int, 4>{60, 60, 60, 50});
   CHECK(nv.data[((7ul * 60 + 30) * 60 + 30) * 60 + 30] == Approx(fl[((30ul * 60 + 30) * 60 + 30) * 50 + 7]));
 }
+
+// Catches wrong source profiles: a Gaussian beam's 1/e^2 waist w gives <r^2> = w^2 / 2, a
+// uniform disc of radius R gives R^2 / 2 (measured on the far face of a clear slab from the
+// exitance image, pixel centres plus h^2/6 for the spread inside a pixel), a Gaussian pulse of
+// FWHM f gives exit times with standard deviation f / 2.3548 around offset + n d / c, and an
+// isotropic point at the centre of a clear cube sends 1/6 of the light through each face.
+TEST_CASE("sources have their documented profiles", "[tissue]") {
+  const int n = 100;
+  const double h = 0.1;
+  for (int type = 0; type < 2; ++type) {
+    Setup s = tissue_box(n, n, 1, h, TissueOptics{0, 0, 0, 1.0});
+    s.source.type = type == 0 ? Source::Type::Gaussian : Source::Type::Disk;
+    s.source.waist = 1.0;
+    s.source.radius = 2.0;
+    s.source.position = {5, 5, -3};
+    s.source.fwhm_ps = 10;
+    s.source.offset_ps = 50;
+    s.time = TimeAxis{0, 100, 1};
+    s.faces = true;
+    s.fluence = false;
+    s.detectors = {{{5, 5, h}, 100.0, 0.0}};
+    s.photons = 20000;
+    const Result r = simulate(s);
+    const std::vector<float>& img = r.face_exitance[5];
+    double w = 0, r2 = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const double x = (i + 0.5) * h - 5, y = (j + 0.5) * h - 5, e = img[static_cast<size_t>(i * n + j)];
+        w += e, r2 += e * (x * x + y * y + h * h / 6);
+      }
+    r2 /= w;
+    const double expected = type == 0 ? 0.5 : 2.0, N = static_cast<double>(s.photons);
+    // Var(r^2): exponential (Gaussian beam): mean^2; uniform disc: R^4/12.
+    const double se = type == 0 ? expected / std::sqrt(N) : 4.0 / std::sqrt(12 * N);
+    INFO((type == 0 ? "gaussian" : "disk") << ": <r^2> " << r2 << " expected " << expected << " +- " << se);
+    CHECK(std::abs(r2 - expected) <= 4 * se);
+    // Pulse: exit times.
+    double m = 0, m2 = 0;
+    for (double t : r.detected.time_ps) m += t, m2 += t * t;
+    const double k = static_cast<double>(r.detected.size());
+    REQUIRE(k == N);
+    m /= k;
+    const double sd = std::sqrt(m2 / k - m * m), sigma = 10 / 2.3548200450309493;
+    const double t_flight = (3 + h) / kSpeedOfLight;  // 3 mm of air, then the slab
+    CHECK(std::abs(m - (50 + t_flight)) <= 4 * sigma / std::sqrt(k));
+    CHECK(std::abs(sd - sigma) <= 4 * sigma / std::sqrt(2 * k));
+  }
+  Setup s = tissue_box(10, 10, 10, 1.0, TissueOptics{0, 0, 0, 1.0});
+  s.source.type = Source::Type::Isotropic;
+  s.source.position = {5, 5, 5};
+  s.time = TimeAxis{0, 100, 1};
+  s.fluence = false;
+  s.photons = 60000;
+  const Result r = simulate(s);
+  const double N = static_cast<double>(s.photons), se = std::sqrt(N * (1.0 / 6) * (5.0 / 6));
+  for (double f : r.balance.escaped_faces) CHECK(std::abs(f - N / 6) <= 4 * se);
+}
