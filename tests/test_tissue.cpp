@@ -10,6 +10,7 @@
 #include "core/bsdf/fresnel.h"
 #include "core/io/nifti.h"
 #include "core/io/npy.h"
+#include "core/tissue/pulse.h"
 #include "core/tissue/scene.h"
 #include "core/tissue/simulate.h"
 #include "media/label_grid_vdb.h"
@@ -400,4 +401,35 @@ TEST_CASE("sources have their documented profiles", "[tissue]") {
   const Result r = simulate(s);
   const double N = static_cast<double>(s.photons), se = std::sqrt(N * (1.0 / 6) * (5.0 / 6));
   for (double f : r.balance.escaped_faces) CHECK(std::abs(f - N / 6) <= 4 * se);
+}
+
+// Catches wrong pulse moments or intervals: a sampled Gaussian pulse histogram has the pulse's
+// mean, its rms width (after Sheppard's correction) and its peak; identical batches give zero
+// jackknife errors, and a flat-topped noisy TPSF has its peak flagged as noise-decided.
+TEST_CASE("pulse statistics of a TPSF with jackknife intervals", "[tissue]") {
+  const TimeAxis axis{0, 10, 60};
+  const double mu = 233, sigma = 41;
+  std::vector<double> h(60);
+  for (int j = 0; j < 60; ++j) {
+    const double a = (axis.bin_start_ps(j) - mu) / (sigma * std::sqrt(2.0)), b = (axis.bin_start_ps(j + 1) - mu) / (sigma * std::sqrt(2.0));
+    h[static_cast<size_t>(j)] = 0.5 * (std::erf(b) - std::erf(a));
+  }
+  const PulseStats s = pulse_stats(axis, std::vector<std::vector<double>>(5, h));
+  REQUIRE(s.defined);
+  CHECK(s.mean.value == Approx(mu).margin(1e-6));
+  CHECK(s.rms.value == Approx(sigma).epsilon(1e-4));  // Sheppard: exact to O(bin^4 / sigma^3)
+  CHECK(s.peak.value == Approx(mu).margin(0.5));      // a parabola through three gates
+  CHECK(s.mean.se == Approx(0).margin(1e-9));
+  CHECK(!s.peak_noise_limited);
+  CHECK(!s.width_noise_limited);
+  // Noisy flat top: Poisson-like batch noise on a plateau.
+  std::vector<std::vector<double>> noisy(10, std::vector<double>(60, 0.0));
+  Rng rng(3, 4);
+  for (auto& b : noisy)
+    for (int j = 20; j < 40; ++j) b[static_cast<size_t>(j)] = 100 + 10 * (rng.uniform() - 0.5);
+  const PulseStats f = pulse_stats(axis, noisy);
+  CHECK(f.peak_noise_limited);
+  CHECK(f.mean.value == Approx(300).margin(2));
+  CHECK(f.mean.ci_lo < f.mean.value);
+  CHECK(f.mean.ci_hi > f.mean.value);
 }

@@ -1,10 +1,12 @@
 #include "core/tissue/outputs.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include "core/io/atomic_file.h"
 #include "core/io/nifti.h"
 #include "core/io/npy.h"
+#include "core/tissue/pulse.h"
 
 namespace femto::tissue {
 
@@ -23,12 +25,29 @@ nlohmann::json summary_json(const Setup& s, const Result& r) {
     if (r.absorbed_per_label[l] != 0 || l < s.volume.optics.size())
       labels.push_back({{"label", l}, {"absorbed_fraction", r.absorbed_per_label[l] / N}});
   J dets = J::array();
-  for (size_t d = 0; d < s.detectors.size(); ++d)
+  const size_t T = static_cast<size_t>(r.gates), D = s.detectors.size();
+  auto num = [](double x) { return std::isfinite(x) ? J(x) : J(nullptr); };
+  for (size_t d = 0; d < D; ++d) {
+    std::vector<std::vector<double>> batches(static_cast<size_t>(r.batches), std::vector<double>(T));
+    for (size_t k = 0; k < batches.size(); ++k)
+      for (size_t g = 0; g < T; ++g) batches[k][g] = r.tpsf_batches[(k * D + d) * T + g];
+    const PulseStats ps = pulse_stats(s.time, batches);
+    auto stat = [&](const PulseStat& st) {
+      return J{{"value_ps", num(st.value)}, {"jackknife_se_ps", num(st.se)}, {"ci95_ps", {num(st.ci_lo), num(st.ci_hi)}}};
+    };
+    J pulse = ps.defined ? J{{"mean_time", stat(ps.mean)},
+                             {"rms_width", stat(ps.rms)},
+                             {"peak_time", stat(ps.peak)},
+                             {"peak_noise_limited", ps.peak_noise_limited},
+                             {"width_noise_limited", ps.width_noise_limited}}
+                         : J(nullptr);
     dets.push_back({{"index", d},
                     {"position_mm", {s.detectors[d].center.x, s.detectors[d].center.y, s.detectors[d].center.z}},
                     {"radius_mm", s.detectors[d].radius},
                     {"na", s.detectors[d].na},
-                    {"detected_fraction", r.detected_weight[d] / N}});
+                    {"detected_fraction", r.detected_weight[d] / N},
+                    {"pulse", pulse}});
+  }
   const double ms = r.seconds * 1e3;
   return J{{"photons", r.photons},
            {"absorbed_fraction", b.absorbed / N},
