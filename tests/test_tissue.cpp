@@ -52,12 +52,14 @@ Setup two_label_cube() {
 // Catches weight lost or counted twice at reflections, refractions, escapes, the window end or
 // the source's specular reflection: per photon, absorbed + carried is the launched weight.
 TEST_CASE("tissue energy balance holds to machine precision", "[tissue]") {
-  for (bool fresnel : {true, false}) {
+  for (int mode = 0; mode < 3; ++mode) {
+    const bool fresnel = mode != 1;
     Setup s = two_label_cube();
     s.fresnel = fresnel;
+    s.absorption = mode == 2 ? Absorption::Analog : Absorption::Weighted;
     const Result r = simulate(s);
     const Balance& b = r.balance;
-    INFO("fresnel " << fresnel << ": absorbed " << b.absorbed << " escaped " << b.escaped() << " alive "
+    INFO("mode " << mode << ": absorbed " << b.absorbed << " escaped " << b.escaped() << " alive "
                     << b.alive << " specular " << b.specular << " missed " << b.missed);
     CHECK(b.launched == static_cast<double>(s.photons));
     CHECK(std::abs(b.residual()) <= 1e-12 * b.launched);
@@ -432,4 +434,28 @@ TEST_CASE("pulse statistics of a TPSF with jackknife intervals", "[tissue]") {
   CHECK(f.mean.value == Approx(300).margin(2));
   CHECK(f.mean.ci_lo < f.mean.value);
   CHECK(f.mean.ci_hi > f.mean.value);
+}
+
+// Catches analog absorption that differs from the weighted estimator it must agree with on
+// average (collision rate mu_t, absorption probability mu_a / mu_t): absorbed energy per label
+// and escaped energy agree within 4 standard errors (bounded by p (1 - p) / N per run, since
+// every photon's share lies in [0, 1]).
+TEST_CASE("analog and weighted absorption agree", "[tissue]") {
+  Setup s = two_label_cube();
+  s.photons = 40000;
+  s.fluence = false;
+  const Result w = simulate(s);
+  s.absorption = Absorption::Analog;
+  s.seed = 99;
+  const Result a = simulate(s);
+  const double N = static_cast<double>(s.photons);
+  auto check = [&](double x, double y, const char* what) {
+    const double p = 0.5 * (x + y) / N, se = std::sqrt(2 * p * (1 - p) / N);
+    INFO(what << ": weighted " << x / N << ", analog " << y / N << " +- " << se);
+    CHECK(std::abs(x - y) / N <= 4 * se);
+  };
+  check(w.absorbed_per_label[1], a.absorbed_per_label[1], "label 1");
+  check(w.absorbed_per_label[2], a.absorbed_per_label[2], "label 2");
+  check(w.balance.escaped(), a.balance.escaped(), "escaped");
+  check(w.balance.alive, a.balance.alive, "alive");
 }
