@@ -459,3 +459,45 @@ TEST_CASE("analog and weighted absorption agree", "[tissue]") {
   check(w.balance.escaped(), a.balance.escaped(), "escaped");
   check(w.balance.alive, a.balance.alive, "alive");
 }
+
+// Catches wrong per-voxel batch standard errors: identical photons give zero (up to rounding), and a disc
+// beam through a clear slab, where each photon crosses one voxel column with track h (a
+// Bernoulli per voxel with p = the column's share of the disc), gives sum_c se_c^2 =
+// sum_c p_c (1 - p_c) h^2 / (N V^2) in expectation; the sum of B-batch variance estimates over
+// K columns scatters by sqrt(2 / ((B - 1) K)) relatively, so it must lie within 4 of those.
+TEST_CASE("per-voxel fluence standard errors from batches", "[tissue]") {
+  {
+    Setup s = tissue_box(3, 3, 10, 0.5, TissueOptics{0.3, 0.0, 0.0, 1.0});
+    s.time = TimeAxis{0, 7.0, 4};
+    s.photons = 50;
+    s.batches = 5;
+    s.fluence_stderr = true;
+    const Result r = simulate(s);
+    for (size_t i = 0; i < r.fluence.size(); ++i) CHECK(r.fluence_err[i] <= 1e-6 * r.fluence[i]);  // rounding only
+  }
+  const int n = 40;
+  const double h = 0.25, V = h * h * h;
+  Setup s = tissue_box(n, n, 1, h, TissueOptics{0, 0, 0, 1.0});
+  s.source.type = Source::Type::Disk;
+  s.source.radius = 4.0;
+  s.source.position = {5, 5, -1};
+  s.time = TimeAxis{0, 100, 1};
+  s.photons = 100000;
+  s.batches = 20;
+  s.fluence_stderr = true;
+  const Result r = simulate(s);
+  const double N = static_cast<double>(s.photons);
+  double se2 = 0, expected = 0;
+  int K = 0;
+  for (size_t c = 0; c < r.fluence.size(); ++c) {
+    const double p = r.fluence[c] * V / h;
+    if (p <= 0) continue;
+    ++K;
+    se2 += static_cast<double>(r.fluence_err[c]) * r.fluence_err[c];
+    expected += p * (1 - p) * h * h / (N * V * V);
+  }
+  const double rel = std::sqrt(2.0 / ((s.batches - 1) * K));
+  INFO(K << " columns: sum se^2 " << se2 << ", expected " << expected << " (relative sd " << rel << ")");
+  REQUIRE(K > 500);
+  CHECK(std::abs(se2 / expected - 1) <= 4 * rel);
+}

@@ -95,6 +95,8 @@ NiftiVolume read_nifti(const std::string& path) {
     v.pixdim[static_cast<size_t>(i)] = get<float>(hdr, kPixdim + 4 * static_cast<size_t>(i + 1), swap);
     count *= static_cast<uint64_t>(d);
   }
+  if (count > (uint64_t{1} << 28))
+    throw InputError(path + ": " + std::to_string(count) + " values, above the limit of 2^28");
   v.datatype = get<int16_t>(hdr, kDatatype, swap);
   const int nb = bytes_of(v.datatype);
   if (nb == 0)
@@ -117,7 +119,7 @@ NiftiVolume read_nifti(const std::string& path) {
   if (!std::isfinite(inter)) inter = 0;
   v.data.resize(count);
   for (uint64_t i = 0; i < count; ++i)
-    v.data[i] = slope * value_at(raw.data() + i * static_cast<uint64_t>(nb), v.datatype, swap) + inter;
+    v.data[i] = static_cast<float>(slope * value_at(raw.data() + i * static_cast<uint64_t>(nb), v.datatype, swap) + inter);
   return v;
 }
 

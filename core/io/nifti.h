@@ -12,11 +12,12 @@ struct NiftiVolume {
   std::array<int, 4> dim{1, 1, 1, 1};        ///< nx, ny, nz, nt (1 when absent)
   std::array<double, 4> pixdim{1, 1, 1, 1};  ///< voxel size (mm when xyzt_units says so) and dt
   int datatype = 0;                          ///< NIfTI datatype code of the file
-  std::vector<double> data;                  ///< values, x fastest (NIfTI order), scaled by scl_slope/inter
+  std::vector<float> data;                   ///< values as float32, x fastest (NIfTI order), scaled by scl_slope/inter
 };
 
 /// Reads a .nii file (either byte order; integer and float datatypes). Throws InputError naming
-/// the file and the problem (not NIfTI-1, unsupported datatype, truncated data, more than 4 dims).
+/// the file and the problem (not NIfTI-1, unsupported datatype, truncated data, more than 4 dims,
+/// more than 2^28 values).
 NiftiVolume read_nifti(const std::string& path);
 
 /// Writes a float32 NIfTI-1 file, atomically. `data` is x fastest (NIfTI order), dims up to 4;

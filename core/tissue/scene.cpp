@@ -17,8 +17,10 @@ namespace {
 using Json = nlohmann::json;
 using Keys = std::vector<std::string>;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kMaxCells = 1073741824.0;  // 2^30 voxels
+constexpr double kMaxCells = 268435456.0;    // 2^28 label voxels (512 MiB of labels)
+constexpr double kMaxTallyCells = 68719476736.0;  // 2^36 fluence cells x gates: bounds every size computation
 constexpr int kMaxLabel = 65535;
+constexpr int kMaxNesting = 64;  // JSON depth, as for camera scenes
 
 std::string fmt(double v) {
   char buf[32];
@@ -117,7 +119,11 @@ class Reader {
 Json parse_strict(const std::string& text, const std::string& source) {
   // Duplicate keys are errors (nlohmann keeps the last one silently).
   std::vector<std::set<std::string>> keys;
-  const Json::parser_callback_t cb = [&](int, Json::parse_event_t ev, Json& parsed) {
+  const Json::parser_callback_t cb = [&](int depth, Json::parse_event_t ev, Json& parsed) {
+    if ((ev == Json::parse_event_t::object_start || ev == Json::parse_event_t::array_start) &&
+        depth >= kMaxNesting)
+      throw InputError(clip(source, 200) + ": values are nested more than " + std::to_string(kMaxNesting) +
+                       " levels deep; a tissue scene needs far fewer");
     if (ev == Json::parse_event_t::object_start) keys.emplace_back();
     if (ev == Json::parse_event_t::object_end) keys.pop_back();
     if (ev == Json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second)
@@ -126,6 +132,8 @@ Json parse_strict(const std::string& text, const std::string& source) {
   };
   try {
     return Json::parse(text, cb, true, true);
+  } catch (const InputError&) {
+    throw;
   } catch (const nlohmann::json::exception& e) {
     throw InputError(clip(source, 200) + ": not valid JSON (" + clip(e.what(), 200) + ")");
   }
@@ -136,8 +144,7 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
   const int sources = (j.contains("fill") ? 1 : 0) + (j.contains("nifti") ? 1 : 0) + (j.contains("vdb") ? 1 : 0);
   if (sources != 1) rd.fail(P, "needs exactly one of \"fill\" (with \"shape\"), \"nifti\" or \"vdb\"", j);
   LabelVolume& v = s.volume;
-  std::vector<int64_t> labels;
-  std::string what;  // for label errors
+  std::vector<uint16_t>& labels = v.labels;
   if (j.contains("fill")) {
     if (!j.contains("shape")) rd.fail(P + "/shape", "required with \"fill\"");
     if (!j.contains("voxel")) rd.fail(P + "/voxel", "required with \"fill\"");
@@ -145,8 +152,8 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
     const int label = static_cast<int>(rd.integer(j["fill"], P + "/fill", 1, kMaxLabel));
     double cells = 1;
     for (int a = 0; a < 3; ++a) v.n[a] = n[static_cast<size_t>(a)], cells *= n[static_cast<size_t>(a)];
-    if (cells > kMaxCells) rd.fail(P + "/shape", "more than 2^30 voxels", j["shape"]);
-    labels.assign(static_cast<size_t>(cells), label);
+    if (cells > kMaxCells) rd.fail(P + "/shape", "more than 2^28 voxels", j["shape"]);
+    labels.assign(static_cast<size_t>(cells), static_cast<uint16_t>(label));
   } else if (j.contains("nifti")) {
     for (const char* k : {"shape", "grid"})
       if (j.contains(k)) rd.fail(P + "/" + k, "applies to \"fill\" / \"vdb\" volumes only");
@@ -160,7 +167,7 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
     if (nv.dim[3] != 1) rd.fail(P + "/nifti", path + ": a label volume has 3 dimensions (dim[4] = " + std::to_string(nv.dim[3]) + ")");
     double cells = 1;
     for (int a = 0; a < 3; ++a) v.n[a] = nv.dim[static_cast<size_t>(a)], cells *= v.n[a];
-    if (cells > kMaxCells) rd.fail(P + "/nifti", path + ": more than 2^30 voxels");
+    if (cells > kMaxCells) rd.fail(P + "/nifti", path + ": more than 2^28 voxels");
     if (!j.contains("voxel")) {
       const auto& pd = nv.pixdim;
       if (!(pd[0] > 0) || std::abs(pd[0] - pd[1]) > 1e-6 * pd[0] || std::abs(pd[0] - pd[2]) > 1e-6 * pd[0])
@@ -177,9 +184,8 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
           if (x != std::floor(x) || x < 0 || x > kMaxLabel)
             rd.fail(P + "/nifti", path + ": voxel (" + std::to_string(i) + ", " + std::to_string(jj) + ", " +
                                       std::to_string(k) + ") holds " + fmt(x) + "; labels are whole numbers 0 to 65535");
-          labels[v.index(i, jj, k)] = static_cast<int64_t>(x);
+          labels[v.index(i, jj, k)] = static_cast<uint16_t>(x);
         }
-    what = path;
   } else {
     if (j.contains("shape")) rd.fail(P + "/shape", "applies to \"fill\" volumes only");
     const std::string path = rd.file(j["vdb"], P + "/vdb");
@@ -192,14 +198,11 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
     for (size_t i = 0; i < labels.size(); ++i) {
       if (d.labels[i] < 0 || d.labels[i] > kMaxLabel)
         rd.fail(P + "/vdb", path + ": label " + std::to_string(d.labels[i]) + " is outside 0 to 65535");
-      labels[i] = d.labels[i];
+      labels[i] = static_cast<uint16_t>(d.labels[i]);
     }
-    what = path;
   }
   if (j.contains("voxel")) v.voxel = rd.number(j["voxel"], P + "/voxel", 1e-6, 1e6);
   if (j.contains("origin")) v.origin = rd.vec3(j["origin"], P + "/origin");
-  v.labels.resize(labels.size());
-  for (size_t i = 0; i < labels.size(); ++i) v.labels[i] = static_cast<uint16_t>(labels[i]);
 }
 
 void read_labels(const Reader& rd, const Json& j, const std::string& P, double outside_n, Setup& s) {
@@ -266,8 +269,20 @@ void read_source(const Reader& rd, const Json& j, const std::string& P, Source& 
 }  // namespace
 
 bool is_tissue_scene(const std::string& text) {
-  const Json j = Json::parse(text, nullptr, false, true);
-  return j.is_object() && j.contains("tissue");
+  // Deeply nested values would make freeing the parsed value recurse past the stack.
+  struct TooDeep {};
+  const Json::parser_callback_t cb = [](int depth, Json::parse_event_t ev, Json&) {
+    if ((ev == Json::parse_event_t::object_start || ev == Json::parse_event_t::array_start) &&
+        depth >= kMaxNesting)
+      throw TooDeep{};
+    return true;
+  };
+  try {
+    const Json j = Json::parse(text, cb, false, true);
+    return j.is_object() && j.contains("tissue");
+  } catch (const TooDeep&) {
+    return false;  // the scene loader reports it
+  }
 }
 
 Setup load_tissue_scene(const std::string& text, const std::string& source, const std::string& base_dir) {
@@ -323,6 +338,12 @@ Setup load_tissue_scene(const std::string& text, const std::string& source, cons
       }
       if (f.contains("stderr")) s.fluence_stderr = rd.boolean(f["stderr"], P + "/fluence/stderr");
     }
+  }
+  if (s.fluence) {
+    const double cells = static_cast<double>(s.fluence_grid.n[0]) * s.fluence_grid.n[1] * s.fluence_grid.n[2];
+    if (cells * s.time.bins > kMaxTallyCells)
+      rd.fail(P + "/fluence", "a fluence volume of " + fmt(cells) + " voxels x " + std::to_string(s.time.bins) +
+                                  " gates is above the limit of 2^36 values; lower its resolution or the gates");
   }
   if (t.contains("faces")) s.faces = rd.boolean(t["faces"], P + "/faces");
   if (t.contains("detectors")) {
