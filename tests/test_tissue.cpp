@@ -501,3 +501,24 @@ TEST_CASE("per-voxel fluence standard errors from batches", "[tissue]") {
   REQUIRE(K > 500);
   CHECK(std::abs(se2 / expected - 1) <= 4 * rel);
 }
+
+// Catches a numerical aperture applied to the wrong angle or medium: an isotropic point 1 mm
+// below the surface of a clear, index-matched slab; a detector covering the face with NA 0.5
+// accepts exactly the cone of half-angle 30 degrees, (1 - cos 30 deg) / 2 of the photons (within
+// 4 binomial standard errors), while without an NA it accepts everything leaving that face.
+TEST_CASE("detector numerical aperture selects the exit cone", "[tissue]") {
+  Setup s = tissue_box(40, 40, 10, 1.0, TissueOptics{0, 0, 0, 1.0});
+  s.source.type = Source::Type::Isotropic;
+  s.source.position = {20.3, 19.8, 1.0};
+  s.time = TimeAxis{0, 1000, 1};
+  s.fluence = false;
+  s.detectors = {{{20, 20, 0}, 30.0, 0.5}, {{20, 20, 0}, 30.0, 0.0}};
+  s.photons = 40000;
+  const Result r = simulate(s);
+  const double N = static_cast<double>(s.photons), p = (1 - std::cos(kPi / 6)) / 2;
+  const double got = r.detected_weight[0] / N;
+  INFO("NA 0.5: " << got << " expected " << p);
+  CHECK(std::abs(got - p) <= 4 * std::sqrt(p * (1 - p) / N));
+  // The second detector sees the rest of the face (a photon counts for the first detector only).
+  CHECK(r.detected_weight[0] + r.detected_weight[1] == Approx(r.balance.escaped_faces[4]).epsilon(1e-12));
+}
