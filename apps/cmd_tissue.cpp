@@ -74,32 +74,38 @@ int cmd_tissue(const std::vector<std::string>& argv, const std::string& command_
       args.fail("only one scene file may be given", a);
     }
   }
-  if (scene_path.empty()) throw InputError("femto tissue: a scene file is required (see femto tissue --help)");
+  if (scene_path.empty())
+    throw InputError("femto tissue: a scene file is required (see femto tissue --help)");
   const std::string text = read_scene_text(scene_path);
   if (!tissue::is_tissue_scene(text))
-    throw InputError(scene_path + ": /tissue: required by femto tissue (a scene with a \"tissue\" section)");
+    throw InputError(scene_path +
+                     ": /tissue: required by femto tissue (a scene with a \"tissue\" section)");
   return run_tissue_scene(text, scene_path, opt, command_line);
 }
 }  // namespace
 
 int run_tissue_scene(const std::string& text, const std::string& path, const TissueRunOptions& opt,
                      const std::string& command_line) {
-  tissue::Setup s = tissue::load_tissue_scene(text, path, std::filesystem::path(path).parent_path().string());
+  tissue::Setup s =
+      tissue::load_tissue_scene(text, path, std::filesystem::path(path).parent_path().string());
   if (opt.photons) s.photons = *opt.photons;
   if (opt.seed) s.seed = *opt.seed;
   s.threads = opt.threads;
   s.quiet = opt.quiet;
   const int threads = tissue::threads_for(s);
-  const uint64_t max_memory = opt.max_memory ? opt.max_memory : cli::physical_memory_bytes() / 4 * 3;
+  const uint64_t max_memory =
+      opt.max_memory ? opt.max_memory : cli::physical_memory_bytes() / 4 * 3;
   const uint64_t need = tissue::memory_bytes(s, threads);
-  const uint64_t volume_bytes = s.fluence ? s.fluence_grid.cells() * static_cast<uint64_t>(s.time.bins) : 0;
+  const uint64_t volume_bytes =
+      s.fluence ? s.fluence_grid.cells() * static_cast<uint64_t>(s.time.bins) : 0;
   if (need > max_memory)
-    throw InputError(path + ": the run needs " + cli::format_bytes(need) + " (fluence volume " +
-                     std::to_string(s.fluence_grid.n[0]) + " x " + std::to_string(s.fluence_grid.n[1]) + " x " +
-                     std::to_string(s.fluence_grid.n[2]) + " x " + std::to_string(s.time.bins) +
-                     " gates, summed per thread, and the label volume), more than --max-memory " +
-                     cli::format_bytes(max_memory) +
-                     ": lower /tissue/fluence/resolution or /tissue/time/bins, or raise --max-memory");
+    throw InputError(
+        path + ": the run needs " + cli::format_bytes(need) + " (fluence volume " +
+        std::to_string(s.fluence_grid.n[0]) + " x " + std::to_string(s.fluence_grid.n[1]) + " x " +
+        std::to_string(s.fluence_grid.n[2]) + " x " + std::to_string(s.time.bins) +
+        " gates, summed per thread, and the label volume), more than --max-memory " +
+        cli::format_bytes(max_memory) +
+        ": lower /tissue/fluence/resolution or /tissue/time/bins, or raise --max-memory");
   // The output folder is checked before the run (a foreign folder is bad input).
   {
     std::error_code ec;
@@ -114,41 +120,46 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
     }
   }
   if (!opt.quiet)
-    std::fprintf(stderr,
-                 "femto tissue: %s: %d x %d x %d voxels of %g mm, %zu labels, %s boundary; %llu photons, "
-                 "%d gates of %g ps; memory: fluence volume %s x %d threads + sums, label volume %s, "
-                 "total %s\n",
-                 path.c_str(), s.volume.n[0], s.volume.n[1], s.volume.n[2], s.volume.voxel,
-                 s.volume.optics.size() - 1, s.fresnel ? "Fresnel" : "index-matched",
-                 static_cast<unsigned long long>(s.photons), s.time.bins, s.time.bin_width_ps,
-                 cli::format_bytes(volume_bytes * 8).c_str(), threads,
-                 cli::format_bytes(s.volume.memory_bytes()).c_str(), cli::format_bytes(need).c_str());
+    std::fprintf(
+        stderr,
+        "femto tissue: %s: %d x %d x %d voxels of %g mm, %zu labels, %s boundary; %llu photons, "
+        "%d gates of %g ps; memory: fluence volume %s x %d threads + sums, label volume %s, "
+        "total %s\n",
+        path.c_str(), s.volume.n[0], s.volume.n[1], s.volume.n[2], s.volume.voxel,
+        s.volume.optics.size() - 1, s.fresnel ? "Fresnel" : "index-matched",
+        static_cast<unsigned long long>(s.photons), s.time.bins, s.time.bin_width_ps,
+        cli::format_bytes(volume_bytes * 8).c_str(), threads,
+        cli::format_bytes(s.volume.memory_bytes()).c_str(), cli::format_bytes(need).c_str());
   OutputFolder folder(opt.out, false);
   const tissue::Result r = tissue::simulate(s);
-  nlohmann::json record = {{"femto_version", FEMTO_VERSION},
-                           {"femto_build", FEMTO_GIT_DESCRIBE},
-                           {"command", command_line},
-                           {"date_utc", cli::utc_now()},
-                           {"mode", "tissue"},
-                           {"scene", {{"source", path}, {"json", nlohmann::json::parse(text, nullptr, false, true)}}},
-                           {"seed", s.seed},
-                           {"threads", r.threads},
-                           {"memory_bytes_estimate", need}};
+  nlohmann::json record = {
+      {"femto_version", FEMTO_VERSION},
+      {"femto_build", FEMTO_GIT_DESCRIBE},
+      {"command", command_line},
+      {"date_utc", cli::utc_now()},
+      {"mode", "tissue"},
+      {"scene", {{"source", path}, {"json", nlohmann::json::parse(text, nullptr, false, true)}}},
+      {"seed", s.seed},
+      {"threads", r.threads},
+      {"memory_bytes_estimate", need}};
   const std::vector<std::string> files = tissue::write_outputs(folder.staging(), s, r, record);
   folder.commit();
   if (!opt.quiet) {
     const double N = static_cast<double>(r.photons);
     std::fprintf(stderr,
-                 "femto tissue: %llu photons in %s (%d threads, %.1f photons/ms); absorbed %.6f, escaped %.6f, "
+                 "femto tissue: %llu photons in %s (%d threads, %.1f photons/ms); absorbed %.6f, "
+                 "escaped %.6f, "
                  "alive at window end %.6f, balance residual %.2e\n",
-                 static_cast<unsigned long long>(r.photons), format_duration(r.seconds).c_str(), r.threads,
-                 N / (r.seconds * 1e3), r.balance.absorbed / N, r.balance.escaped() / N, r.balance.alive / N,
-                 r.balance.residual() / N);
-    std::fprintf(stderr, "femto tissue: results in %s/ (%zu files)\n", opt.out.c_str(), files.size());
+                 static_cast<unsigned long long>(r.photons), format_duration(r.seconds).c_str(),
+                 r.threads, N / (r.seconds * 1e3), r.balance.absorbed / N, r.balance.escaped() / N,
+                 r.balance.alive / N, r.balance.residual() / N);
+    std::fprintf(stderr, "femto tissue: results in %s/ (%zu files)\n", opt.out.c_str(),
+                 files.size());
   }
   return 0;
 }
 
-FEMTO_COMMAND("tissue", "time-resolved tissue optics on a labelled volume (fluence, TPSFs)", cmd_tissue);
+FEMTO_COMMAND("tissue", "time-resolved tissue optics on a labelled volume (fluence, TPSFs)",
+              cmd_tissue);
 
 }  // namespace femto

@@ -40,7 +40,8 @@ LabelGridData read_vdb_labels(const std::string& path, const std::string& name,
   }
   const openvdb::math::Transform& tf = grid->transform();
   const openvdb::Vec3d vs = tf.voxelSize();
-  if (!tf.isLinear() || std::abs(vs.x() - vs.y()) > 1e-9 * vs.x() || std::abs(vs.x() - vs.z()) > 1e-9 * vs.x())
+  if (!tf.isLinear() || std::abs(vs.x() - vs.y()) > 1e-9 * vs.x() ||
+      std::abs(vs.x() - vs.z()) > 1e-9 * vs.x())
     throw InputError(at + "grid '" + clip(name) + "' needs a linear transform with cubic voxels");
   const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
   if (box.empty()) throw InputError(at + "grid '" + clip(name) + "' has no active voxels");
@@ -52,14 +53,16 @@ LabelGridData read_vdb_labels(const std::string& path, const std::string& name,
   }
   if (cells > kMaxCells) throw InputError(at + "the active box has more than 2^30 cells");
   out.voxel = vs.x();
-  const openvdb::Vec3d lo = tf.indexToWorld(openvdb::Vec3d(box.min().x() - 0.5, box.min().y() - 0.5, box.min().z() - 0.5));
+  const openvdb::Vec3d lo = tf.indexToWorld(
+      openvdb::Vec3d(box.min().x() - 0.5, box.min().y() - 0.5, box.min().z() - 0.5));
   out.origin = {lo.x(), lo.y(), lo.z()};
   out.labels.resize(static_cast<size_t>(cells));
   auto acc = grid->getConstAccessor();
   size_t i = 0;
   for (int x = box.min().x(); x <= box.max().x(); ++x)
     for (int y = box.min().y(); y <= box.max().y(); ++y)
-      for (int z = box.min().z(); z <= box.max().z(); ++z) out.labels[i++] = acc.getValue(openvdb::Coord(x, y, z));
+      for (int z = box.min().z(); z <= box.max().z(); ++z)
+        out.labels[i++] = acc.getValue(openvdb::Coord(x, y, z));
   return out;
 }
 
@@ -74,7 +77,8 @@ void write_vdb_labels(const std::string& path, const std::string& name, const La
         if (d.labels[i] != 0) acc.setValue(openvdb::Coord(x, y, z), d.labels[i]);
   grid->setName(name);
   auto tf = openvdb::math::Transform::createLinearTransform(d.voxel);
-  tf->postTranslate(openvdb::Vec3d(d.origin.x + 0.5 * d.voxel, d.origin.y + 0.5 * d.voxel, d.origin.z + 0.5 * d.voxel));
+  tf->postTranslate(openvdb::Vec3d(d.origin.x + 0.5 * d.voxel, d.origin.y + 0.5 * d.voxel,
+                                   d.origin.z + 0.5 * d.voxel));
   grid->setTransform(tf);
   write_atomically(path, [&](const std::string& tmp) {
     openvdb::io::File file(tmp);

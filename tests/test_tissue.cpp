@@ -60,7 +60,7 @@ TEST_CASE("tissue energy balance holds to machine precision", "[tissue]") {
     const Result r = simulate(s);
     const Balance& b = r.balance;
     INFO("mode " << mode << ": absorbed " << b.absorbed << " escaped " << b.escaped() << " alive "
-                    << b.alive << " specular " << b.specular << " missed " << b.missed);
+                 << b.alive << " specular " << b.specular << " missed " << b.missed);
     CHECK(b.launched == static_cast<double>(s.photons));
     CHECK(std::abs(b.residual()) <= 1e-12 * b.launched);
     CHECK(b.absorbed > 0);
@@ -115,14 +115,16 @@ TEST_CASE("fluence of an unscattered beam is the exact integral of its weight", 
       // Depth interval of voxel k inside gate g: z in [k h, (k+1) h] and z = v t.
       const double z0 = std::max(k * h, v * s.time.bin_start_ps(g));
       const double z1 = std::min((k + 1) * h, v * s.time.bin_start_ps(g + 1));
-      const double expected = z1 > z0 ? (std::exp(-mu_a * z0) - std::exp(-mu_a * z1)) / mu_a / (h * h * h) : 0.0;
+      const double expected =
+          z1 > z0 ? (std::exp(-mu_a * z0) - std::exp(-mu_a * z1)) / mu_a / (h * h * h) : 0.0;
       const size_t i = s.volume.index(1, 1, k) * T + static_cast<size_t>(g);
       INFO("voxel " << k << " gate " << g);
       CHECK(r.fluence[i] == Approx(expected).epsilon(1e-6).margin(1e-9));
       CHECK(r.fluence[s.volume.index(0, 1, k) * T + static_cast<size_t>(g)] == 0);
     }
   // Beyond the window's reach (v t_end = 14 mm of 20) the rest is alive.
-  CHECK(r.balance.alive / static_cast<double>(s.photons) == Approx(std::exp(-mu_a * v * s.time.t_end_ps())).epsilon(1e-12));
+  CHECK(r.balance.alive / static_cast<double>(s.photons) ==
+        Approx(std::exp(-mu_a * v * s.time.t_end_ps())).epsilon(1e-12));
 }
 
 // Catches a fluence grid of its own resolution and placement summed differently from the label
@@ -146,7 +148,9 @@ TEST_CASE("a fluence grid of its own resolution sums the fine grid's cells", "[t
           for (int di = 0; di < 2; ++di)
             for (int dj = 0; dj < 2; ++dj)
               for (int dk = 0; dk < 2; ++dk)
-                sum += fine.fluence[s.volume.index(1 + 2 * I + di, 1 + 2 * J + dj, 1 + 2 * K + dk) * T + g];
+                sum += fine.fluence[s.volume.index(1 + 2 * I + di, 1 + 2 * J + dj, 1 + 2 * K + dk) *
+                                        T +
+                                    g];
           const double c = coarse.fluence[((static_cast<size_t>(I) * 5 + J) * 5 + K) * T + g];
           CHECK(c == Approx(sum / 8).epsilon(1e-5).margin(1e-7));
         }
@@ -155,7 +159,8 @@ TEST_CASE("a fluence grid of its own resolution sums the fine grid's cells", "[t
 // Catches a wrong Fresnel reflectance or Snell refraction at a voxel face between labels: a
 // clear two-index box, an oblique pencil beam; the fraction transmitted is T(theta) within 4
 // binomial standard errors and the transmitted photons leave the far face where Snell puts them.
-TEST_CASE("an interface between labels reflects with Fresnel's R and refracts by Snell's law", "[tissue]") {
+TEST_CASE("an interface between labels reflects with Fresnel's R and refracts by Snell's law",
+          "[tissue]") {
   const double n1 = 1.0, n2 = 1.5, theta = 50 * kPi / 180;
   Setup s = tissue_box(40, 10, 20, 1.0, TissueOptics{0, 0, 0, n1}, n1);
   s.volume.optics.push_back(TissueOptics{0, 0, 0, n2});
@@ -181,9 +186,10 @@ TEST_CASE("an interface between labels reflects with Fresnel's R and refracts by
   // First pass through the interface: straight out of the far face (outside n = n2) at the
   // Snell point. The reflected part reaches the near face (n1 -> n2, same angle): T of it leaves.
   const double got = r.detected_weight[0] / N, back = r.balance.escaped_faces[4] / N;
-  const double se = std::sqrt(T * (1 - T) / N), se_back = std::sqrt((1 - T) * T * (1 - (1 - T) * T) / N);
-  INFO("transmitted " << got << " expected " << T << " +- " << se << "; back out " << back << " expected "
-                      << (1 - T) * T << " +- " << se_back);
+  const double se = std::sqrt(T * (1 - T) / N),
+               se_back = std::sqrt((1 - T) * T * (1 - (1 - T) * T) / N);
+  INFO("transmitted " << got << " expected " << T << " +- " << se << "; back out " << back
+                      << " expected " << (1 - T) * T << " +- " << se_back);
   CHECK(std::abs(got - T) <= 4 * se);
   CHECK(std::abs(back - (1 - T) * T) <= 4 * se_back);
 }
@@ -223,7 +229,8 @@ TEST_CASE("detected photons re-weighted to new mu_a reproduce a direct run", "[t
     const int g = s.time.bin_of(d.time_ps[i]);
     if (g >= 0) tpsf[static_cast<size_t>(g)] += w;
   }
-  const double unit = 1.0 / (static_cast<double>(s.photons) * kPi * 2.5 * 2.5 * s.time.bin_width_ps);
+  const double unit =
+      1.0 / (static_cast<double>(s.photons) * kPi * 2.5 * 2.5 * s.time.bin_width_ps);
   for (size_t g = 0; g < T; ++g) {
     const double rw = tpsf[g] * unit;
     INFO("gate " << g << ": re-weighted " << rw << ", same seed " << same.tpsf[g] << ", other seed "
@@ -241,7 +248,9 @@ TEST_CASE("label volumes load from NIfTI-1 and OpenVDB", "[tissue]") {
   std::vector<float> data(24);
   for (int k = 0; k < 2; ++k)
     for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 4; ++i) data[static_cast<size_t>((k * 3 + j) * 4 + i)] = static_cast<float>(i == 3 ? 2 : (k == 1 ? 1 : 0));
+      for (int i = 0; i < 4; ++i)
+        data[static_cast<size_t>((k * 3 + j) * 4 + i)] =
+            static_cast<float>(i == 3 ? 2 : (k == 1 ? 1 : 0));
   const std::string nii = (tmp.dir / "labels.nii").string();
   write_nifti_float32(nii, dim, {0.5, 0.5, 0.5, 1}, data.data());
   const NiftiVolume nv = read_nifti(nii);
@@ -250,8 +259,9 @@ TEST_CASE("label volumes load from NIfTI-1 and OpenVDB", "[tissue]") {
   const std::string labels =
       R"("labels": [{"label": 1, "mu_a": 0.1, "mu_s": 1, "g": 0, "n": 1.4}, {"label": 2, "mu_a": 0.2, "mu_s": 2, "g": 0.5, "n": 1.3}],)"
       R"("source": {"type": "isotropic", "position": [1, 1, 0.75]}, "time": {"bin_width": 10, "bins": 2}})";
-  const Setup s = load_tissue_scene(R"({"tissue": {"volume": {"nifti": "labels.nii"},)" + labels + "}",
-                                    "t.json", tmp.dir.string());
+  const Setup s =
+      load_tissue_scene(R"({"tissue": {"volume": {"nifti": "labels.nii"},)" + labels + "}",
+                        "t.json", tmp.dir.string());
   CHECK(s.volume.n[0] == 4);
   CHECK(s.volume.n[2] == 2);
   CHECK(s.volume.voxel == 0.5);
@@ -259,11 +269,14 @@ TEST_CASE("label volumes load from NIfTI-1 and OpenVDB", "[tissue]") {
   CHECK(s.volume.label_at(1, 2, 1) == 1);
   CHECK(s.volume.label_at(1, 2, 0) == 0);
   CHECK(s.volume.optics[2].n == 1.3);
-  CHECK_THROWS_WITH(load_tissue_scene(R"({"tissue": {"volume": {"nifti": "labels.nii"},)" +
-                                          labels.substr(0, labels.find("{\"label\": 2")) + "{\"label\": 3, \"mu_a\": 0, \"mu_s\": 1, \"g\": 0, \"n\": 1}]," +
-                                          labels.substr(labels.find("\"source\"")) + "}",
-                                      "t.json", tmp.dir.string()),
-                    Catch::Contains("t.json: /tissue/labels: label 2 occurs in the volume but has no optical properties"));
+  CHECK_THROWS_WITH(
+      load_tissue_scene(R"({"tissue": {"volume": {"nifti": "labels.nii"},)" +
+                            labels.substr(0, labels.find("{\"label\": 2")) +
+                            "{\"label\": 3, \"mu_a\": 0, \"mu_s\": 1, \"g\": 0, \"n\": 1}]," +
+                            labels.substr(labels.find("\"source\"")) + "}",
+                        "t.json", tmp.dir.string()),
+      Catch::Contains(
+          "t.json: /tissue/labels: label 2 occurs in the volume but has no optical properties"));
 
   LabelGridData g;
   g.n = {3, 2, 2};
@@ -272,8 +285,8 @@ TEST_CASE("label volumes load from NIfTI-1 and OpenVDB", "[tissue]") {
   g.labels = {1, 1, 1, 2, 1, 1, 1, 1, 1, 1, 2, 1};
   const std::string vdb = (tmp.dir / "labels.vdb").string();
   write_vdb_labels(vdb, "labels", g);
-  const Setup v = load_tissue_scene(R"({"tissue": {"volume": {"vdb": "labels.vdb"},)" + labels + "}", "t.json",
-                                    tmp.dir.string());
+  const Setup v = load_tissue_scene(
+      R"({"tissue": {"volume": {"vdb": "labels.vdb"},)" + labels + "}", "t.json", tmp.dir.string());
   CHECK(v.volume.n[0] == 3);
   CHECK(v.volume.voxel == Approx(0.25));
   CHECK(v.volume.origin.x == Approx(1));
@@ -283,18 +296,24 @@ TEST_CASE("label volumes load from NIfTI-1 and OpenVDB", "[tissue]") {
 
 // Catches bad tissue scenes that run anyway or leave files behind: exit 2, one message naming the
 // file, the key and the value, and no output folder.
-TEST_CASE("femto render refuses bad tissue scenes with exit 2 and writes nothing", "[tissue][cli]") {
+TEST_CASE("femto render refuses bad tissue scenes with exit 2 and writes nothing",
+          "[tissue][cli]") {
   femto::test::TempDir tmp("femto_tissue_cli");
-  const std::string good = femto::test::read_file(fs::path(FEMTO_SOURCE_DIR) / "data/scenes/cube60.json");
+  const std::string good =
+      femto::test::read_file(fs::path(FEMTO_SOURCE_DIR) / "data/scenes/cube60.json");
   struct Case {
     std::string from, to, message;
   };
   const std::vector<Case> cases = {
-      {R"("mu_s": 1.0)", R"("mu_s": -1)", "cube.json: /tissue/labels/0/mu_s: must be in [0, 1e+06] (got -1)"},
-      {R"("boundary": "matched")", R"("boundary": "mirror")", "cube.json: /tissue/boundary: must be one of \"fresnel\", \"matched\" (got \"mirror\")"},
+      {R"("mu_s": 1.0)", R"("mu_s": -1)",
+       "cube.json: /tissue/labels/0/mu_s: must be in [0, 1e+06] (got -1)"},
+      {R"("boundary": "matched")", R"("boundary": "mirror")",
+       "cube.json: /tissue/boundary: must be one of \"fresnel\", \"matched\" (got \"mirror\")"},
       {R"("bins": 50)", R"("bins": 50, "binz": 3)", "cube.json: /tissue/time/binz: unknown key"},
-      {R"("fill": 1)", R"("fill": 7)", "cube.json: /tissue/labels: label 7 occurs in the volume but has no optical properties"},
-      {R"("type": "pencil")", R"("type": "laser")", "cube.json: /tissue/source/type: must be one of"},
+      {R"("fill": 1)", R"("fill": 7)",
+       "cube.json: /tissue/labels: label 7 occurs in the volume but has no optical properties"},
+      {R"("type": "pencil")", R"("type": "laser")",
+       "cube.json: /tissue/source/type: must be one of"},
   };
   for (const Case& c : cases) {
     std::string text = good;
@@ -302,7 +321,8 @@ TEST_CASE("femto render refuses bad tissue scenes with exit 2 and writes nothing
     REQUIRE(at != std::string::npos);
     text.replace(at, c.from.size(), c.to);
     femto::test::write_file(tmp.dir / "cube.json", text);
-    const auto run = femto::test::run_femto({"render", "cube.json", "--out", "out", "--photons", "10"}, tmp.dir);
+    const auto run =
+        femto::test::run_femto({"render", "cube.json", "--out", "out", "--photons", "10"}, tmp.dir);
     INFO(run.err);
     CHECK(run.code == 2);
     CHECK(run.err.find(c.message) != std::string::npos);
@@ -310,7 +330,8 @@ TEST_CASE("femto render refuses bad tissue scenes with exit 2 and writes nothing
   }
   // Memory beyond --max-memory is refused before anything is written.
   femto::test::write_file(tmp.dir / "cube.json", good);
-  const auto big = femto::test::run_femto({"render", "cube.json", "--out", "out", "--max-memory", "10M"}, tmp.dir);
+  const auto big = femto::test::run_femto(
+      {"render", "cube.json", "--out", "out", "--max-memory", "10M"}, tmp.dir);
   CHECK(big.code == 2);
   CHECK(big.err.find("more than --max-memory") != std::string::npos);
   CHECK(!fs::exists(tmp.dir / "out"));
@@ -326,26 +347,31 @@ TEST_CASE("femto render refuses bad tissue scenes with exit 2 and writes nothing
 TEST_CASE("femto render runs a tissue scene and writes the documented outputs", "[tissue][cli]") {
   femto::test::TempDir tmp("femto_tissue_run");
   const std::string scene = (fs::path(FEMTO_SOURCE_DIR) / "data/scenes/cube60.json").string();
-  const auto run = femto::test::run_femto({"render", scene, "--out", "out", "--photons", "2000", "--quiet"}, tmp.dir);
+  const auto run = femto::test::run_femto(
+      {"render", scene, "--out", "out", "--photons", "2000", "--quiet"}, tmp.dir);
   INFO(run.err);
   REQUIRE(run.code == 0);
-  for (const char* f : {"fluence.npy", "fluence_rate.npy", "fluence.nii", "tpsf.npy", "tpsf.csv", "detected_photons.npy",
-                        "detected_ppath.npy", "exitance_zmin.npy", "summary.json", "render.json"})
+  for (const char* f : {"fluence.npy", "fluence_rate.npy", "fluence.nii", "tpsf.npy", "tpsf.csv",
+                        "detected_photons.npy", "detected_ppath.npy", "exitance_zmin.npy",
+                        "summary.json", "render.json"})
     CHECK(fs::exists(tmp.dir / "out" / f));
   std::vector<size_t> shape;
   std::vector<float> fl;
   read_npy_float32((tmp.dir / "out/fluence.npy").string(), shape, fl);
   CHECK(shape == std::vector<size_t>{60, 60, 60, 50});
-  const nlohmann::json sum = nlohmann::json::parse(femto::test::read_file(tmp.dir / "out/summary.json"));
+  const nlohmann::json sum =
+      nlohmann::json::parse(femto::test::read_file(tmp.dir / "out/summary.json"));
   double absorbed = 0;
   for (float x : fl) absorbed += x;
-  absorbed *= 0.005;  // mu_a times fluence (1/mm^2) times the 1 mm^3 voxel
+  absorbed *= 0.005;                      // mu_a times fluence (1/mm^2) times the 1 mm^3 voxel
   const double alive_absorbed_after = 0;  // photons stop at the window end: nothing after it
-  CHECK(absorbed == Approx(sum["absorbed_fraction"].get<double>() + alive_absorbed_after).epsilon(1e-4));
+  CHECK(absorbed ==
+        Approx(sum["absorbed_fraction"].get<double>() + alive_absorbed_after).epsilon(1e-4));
   CHECK(std::abs(sum["energy_balance"]["residual"].get<double>()) < 1e-12);
   const NiftiVolume nv = read_nifti((tmp.dir / "out/fluence.nii").string());
   CHECK(nv.dim == std::array<int, 4>{60, 60, 60, 50});
-  CHECK(nv.data[((7ul * 60 + 30) * 60 + 30) * 60 + 30] == Approx(fl[((30ul * 60 + 30) * 60 + 30) * 50 + 7]));
+  CHECK(nv.data[((7ul * 60 + 30) * 60 + 30) * 60 + 30] ==
+        Approx(fl[((30ul * 60 + 30) * 60 + 30) * 50 + 7]));
 }
 
 // Catches wrong source profiles: a Gaussian beam's 1/e^2 waist w gives <r^2> = w^2 / 2, a
@@ -374,14 +400,16 @@ TEST_CASE("sources have their documented profiles", "[tissue]") {
     double w = 0, r2 = 0;
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) {
-        const double x = (i + 0.5) * h - 5, y = (j + 0.5) * h - 5, e = img[static_cast<size_t>(i * n + j)];
+        const double x = (i + 0.5) * h - 5, y = (j + 0.5) * h - 5,
+                     e = img[static_cast<size_t>(i * n + j)];
         w += e, r2 += e * (x * x + y * y + h * h / 6);
       }
     r2 /= w;
     const double expected = type == 0 ? 0.5 : 2.0, N = static_cast<double>(s.photons);
     // Var(r^2): exponential (Gaussian beam): mean^2; uniform disc: R^4/12.
     const double se = type == 0 ? expected / std::sqrt(N) : 4.0 / std::sqrt(12 * N);
-    INFO((type == 0 ? "gaussian" : "disk") << ": <r^2> " << r2 << " expected " << expected << " +- " << se);
+    INFO((type == 0 ? "gaussian" : "disk")
+         << ": <r^2> " << r2 << " expected " << expected << " +- " << se);
     CHECK(std::abs(r2 - expected) <= 4 * se);
     // Pulse: exit times.
     double m = 0, m2 = 0;
@@ -413,7 +441,8 @@ TEST_CASE("pulse statistics of a TPSF with jackknife intervals", "[tissue]") {
   const double mu = 233, sigma = 41;
   std::vector<double> h(60);
   for (int j = 0; j < 60; ++j) {
-    const double a = (axis.bin_start_ps(j) - mu) / (sigma * std::sqrt(2.0)), b = (axis.bin_start_ps(j + 1) - mu) / (sigma * std::sqrt(2.0));
+    const double a = (axis.bin_start_ps(j) - mu) / (sigma * std::sqrt(2.0)),
+                 b = (axis.bin_start_ps(j + 1) - mu) / (sigma * std::sqrt(2.0));
     h[static_cast<size_t>(j)] = 0.5 * (std::erf(b) - std::erf(a));
   }
   const PulseStats s = pulse_stats(axis, std::vector<std::vector<double>>(5, h));
@@ -460,8 +489,8 @@ TEST_CASE("analog and weighted absorption agree", "[tissue]") {
   check(w.balance.alive, a.balance.alive, "alive");
 }
 
-// Catches wrong per-voxel batch standard errors: identical photons give zero (up to rounding), and a disc
-// beam through a clear slab, where each photon crosses one voxel column with track h (a
+// Catches wrong per-voxel batch standard errors: identical photons give zero (up to rounding), and
+// a disc beam through a clear slab, where each photon crosses one voxel column with track h (a
 // Bernoulli per voxel with p = the column's share of the disc), gives sum_c se_c^2 =
 // sum_c p_c (1 - p_c) h^2 / (N V^2) in expectation; the sum of B-batch variance estimates over
 // K columns scatters by sqrt(2 / ((B - 1) K)) relatively, so it must lie within 4 of those.
@@ -473,7 +502,8 @@ TEST_CASE("per-voxel fluence standard errors from batches", "[tissue]") {
     s.batches = 5;
     s.fluence_stderr = true;
     const Result r = simulate(s);
-    for (size_t i = 0; i < r.fluence.size(); ++i) CHECK(r.fluence_err[i] <= 1e-6 * r.fluence[i]);  // rounding only
+    for (size_t i = 0; i < r.fluence.size(); ++i)
+      CHECK(r.fluence_err[i] <= 1e-6 * r.fluence[i]);  // rounding only
   }
   const int n = 40;
   const double h = 0.25, V = h * h * h;
@@ -497,7 +527,8 @@ TEST_CASE("per-voxel fluence standard errors from batches", "[tissue]") {
     expected += p * (1 - p) * h * h / (N * V * V);
   }
   const double rel = std::sqrt(2.0 / ((s.batches - 1) * K));
-  INFO(K << " columns: sum se^2 " << se2 << ", expected " << expected << " (relative sd " << rel << ")");
+  INFO(K << " columns: sum se^2 " << se2 << ", expected " << expected << " (relative sd " << rel
+         << ")");
   REQUIRE(K > 500);
   CHECK(std::abs(se2 / expected - 1) <= 4 * rel);
 }
@@ -520,5 +551,6 @@ TEST_CASE("detector numerical aperture selects the exit cone", "[tissue]") {
   INFO("NA 0.5: " << got << " expected " << p);
   CHECK(std::abs(got - p) <= 4 * std::sqrt(p * (1 - p) / N));
   // The second detector sees the rest of the face (a photon counts for the first detector only).
-  CHECK(r.detected_weight[0] + r.detected_weight[1] == Approx(r.balance.escaped_faces[4]).epsilon(1e-12));
+  CHECK(r.detected_weight[0] + r.detected_weight[1] ==
+        Approx(r.balance.escaped_faces[4]).epsilon(1e-12));
 }

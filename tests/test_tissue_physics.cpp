@@ -67,7 +67,8 @@ class LabelGridTransport final : public diffusion::PhotonTransport {
   Segment advance(Photon& p, Rng& rng) const override {
     if (p.label == 0) {  // a new photon: find its voxel
       const LabelVolume& v = space_.volume();
-      for (int a = 0; a < 3; ++a) p.cell[a] = static_cast<int>(std::floor((p.x[a] - v.origin[a]) / v.voxel));
+      for (int a = 0; a < 3; ++a)
+        p.cell[a] = static_cast<int>(std::floor((p.x[a] - v.origin[a]) / v.voxel));
       p.label = v.label_at(p.cell[0], p.cell[1], p.cell[2]);
     }
     Segment seg;
@@ -85,7 +86,8 @@ class LabelGridTransport final : public diffusion::PhotonTransport {
 // optical thickness 2 with albedo 0.9 and g = 0.75 (mu_a = 1/mm, mu_s = 9/mm, 0.2 mm thick)
 // has total diffuse reflectance 0.09739 and total transmittance (unscattered included) 0.66096
 // in van de Hulst's (1980) tables, the reference of the MCML paper (Wang, Jacques & Zheng 1995).
-TEST_CASE("slab reflectance and transmittance match van de Hulst's table", "[tissue][statistical]") {
+TEST_CASE("slab reflectance and transmittance match van de Hulst's table",
+          "[tissue][statistical]") {
   // 30 x 30 x 0.2 mm; 20 mm of path is a weight of exp(-20): stopping there changes R by < 1e-8.
   Setup s = tissue_box(150, 150, 1, 0.2, TissueOptics{1.0, 9.0, 0.75, 1.0});
   s.time = TimeAxis{0, 20.0 / kSpeedOfLight, 1};
@@ -101,7 +103,8 @@ TEST_CASE("slab reflectance and transmittance match van de Hulst's table", "[tis
     sum[d] += r.detected.weight[i], sum2[d] += r.detected.weight[i] * r.detected.weight[i];
   }
   const double R = sum[0] / N, T = sum[1] / N;
-  const double se_R = std::sqrt((sum2[0] / N - R * R) / (N - 1)), se_T = std::sqrt((sum2[1] / N - T * T) / (N - 1));
+  const double se_R = std::sqrt((sum2[0] / N - R * R) / (N - 1)),
+               se_T = std::sqrt((sum2[1] / N - T * T) / (N - 1));
   INFO("R = " << R << " +- " << se_R << " (0.09739), T = " << T << " +- " << se_T << " (0.66096)");
   CHECK(R == Approx(r.balance.escaped_faces[4] / N).epsilon(1e-12));
   CHECK(T == Approx(r.balance.escaped_faces[5] / N).epsilon(1e-12));
@@ -136,7 +139,8 @@ TEST_CASE("time-resolved semi-infinite reflectance matches extrapolated-boundary
   for (int g = 0; g < s.time.bins; ++g) {
     const double t0 = s.time.bin_start_ps(g), t1 = t0 + s.time.bin_width_ps;
     if (t0 < t_min) continue;
-    const double mc = r.tpsf[static_cast<size_t>(g)] * area, se = r.tpsf_err[static_cast<size_t>(g)] * area;
+    const double mc = r.tpsf[static_cast<size_t>(g)] * area,
+                 se = r.tpsf_err[static_cast<size_t>(g)] * area;
     const double model = contini_gate(t0, t1, mu_a, mu_s, n);
     INFO("gate " << t0 << "-" << t1 << " ps: MC " << mc << " +- " << se << ", diffusion " << model);
     CHECK(std::abs(mc - model) <= 4 * se);
@@ -148,7 +152,8 @@ TEST_CASE("time-resolved semi-infinite reflectance matches extrapolated-boundary
   for (int b = 0; b < B; ++b) {
     double x = 0;
     for (int g = 0; g < s.time.bins; ++g)
-      if (s.time.bin_start_ps(g) >= t_min) x += r.tpsf_batches[static_cast<size_t>(b * s.time.bins + g)] * area;
+      if (s.time.bin_start_ps(g) >= t_min)
+        x += r.tpsf_batches[static_cast<size_t>(b * s.time.bins + g)] * area;
     sq += (x - mc_sum) * (x - mc_sum);
   }
   const double se_sum = std::sqrt(sq / (B * (B - 1.0)));
@@ -160,7 +165,8 @@ TEST_CASE("time-resolved semi-infinite reflectance matches extrapolated-boundary
 // across voxel faces, wrong speed or weight in a voxel. A uniform 41 mm grid around an isotropic
 // source, seen through femto diffusion's exact tallies, must give the exact persistent-random-walk
 // <r^2>(t) within 4 standard errors and the exact weighted energy exp(-mu_a v t).
-TEST_CASE("the labelled-grid walk reproduces the infinite medium's exact <r^2>(t)", "[tissue][statistical]") {
+TEST_CASE("the labelled-grid walk reproduces the infinite medium's exact <r^2>(t)",
+          "[tissue][statistical]") {
   const double mu_a = 0.02, mu_s = 2.0, g = 0.5, n = 1.3;
   LabelVolume v;
   v.n[0] = v.n[1] = v.n[2] = 41;
@@ -181,10 +187,13 @@ TEST_CASE("the labelled-grid walk reproduces the infinite medium's exact <r^2>(t
   const diffusion::DiffusionResult r = diffusion::simulate(s, transport);
   const diffusion::Analysis a = diffusion::analyse(s, r, 0.05);
   for (int j = 0; j < s.grid.time.bins; ++j) {
-    INFO("bin " << j << ": <r^2> " << r.r2[static_cast<size_t>(j)] << " +- " << r.r2_err[static_cast<size_t>(j)]
-                << ", exact " << a.r2_exact[static_cast<size_t>(j)]);
-    CHECK(std::abs(r.r2[static_cast<size_t>(j)] - a.r2_exact[static_cast<size_t>(j)]) <= 4 * r.r2_err[static_cast<size_t>(j)]);
-    CHECK(r.energy[static_cast<size_t>(j)] == Approx(a.energy_exact[static_cast<size_t>(j)]).epsilon(1e-9));
+    INFO("bin " << j << ": <r^2> " << r.r2[static_cast<size_t>(j)] << " +- "
+                << r.r2_err[static_cast<size_t>(j)] << ", exact "
+                << a.r2_exact[static_cast<size_t>(j)]);
+    CHECK(std::abs(r.r2[static_cast<size_t>(j)] - a.r2_exact[static_cast<size_t>(j)]) <=
+          4 * r.r2_err[static_cast<size_t>(j)]);
+    CHECK(r.energy[static_cast<size_t>(j)] ==
+          Approx(a.energy_exact[static_cast<size_t>(j)]).epsilon(1e-9));
   }
 }
 

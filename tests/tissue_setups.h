@@ -5,7 +5,8 @@
 namespace femto::test {
 
 /// A box of nx x ny x nz voxels of edge `voxel`, lower corner at the origin, filled with label 1.
-inline tissue::Setup tissue_box(int nx, int ny, int nz, double voxel, const TissueOptics& o, double outside_n = 1.0) {
+inline tissue::Setup tissue_box(int nx, int ny, int nz, double voxel, const TissueOptics& o,
+                                double outside_n = 1.0) {
   tissue::Setup s;
   LabelVolume& v = s.volume;
   v.n[0] = nx, v.n[1] = ny, v.n[2] = nz;

@@ -37,11 +37,22 @@ void put(std::vector<char>& b, size_t at, T v) {
 
 int bytes_of(int datatype) {
   switch (datatype) {
-    case 2: case 256: return 1;             // uint8, int8
-    case 4: case 512: return 2;             // int16, uint16
-    case 8: case 768: case 16: return 4;    // int32, uint32, float32
-    case 64: case 1024: case 1280: return 8;  // float64, int64, uint64
-    default: return 0;
+    case 2:
+    case 256:
+      return 1;  // uint8, int8
+    case 4:
+    case 512:
+      return 2;  // int16, uint16
+    case 8:
+    case 768:
+    case 16:
+      return 4;  // int32, uint32, float32
+    case 64:
+    case 1024:
+    case 1280:
+      return 8;  // float64, int64, uint64
+    default:
+      return 0;
   }
 }
 
@@ -55,16 +66,26 @@ double value_at(const char* p, int datatype, bool swap) {
     return static_cast<double>(v);
   };
   switch (datatype) {
-    case 2: return as(uint8_t{});
-    case 256: return as(int8_t{});
-    case 4: return as(int16_t{});
-    case 512: return as(uint16_t{});
-    case 8: return as(int32_t{});
-    case 768: return as(uint32_t{});
-    case 16: return as(float{});
-    case 64: return as(double{});
-    case 1024: return as(int64_t{});
-    default: return as(uint64_t{});
+    case 2:
+      return as(uint8_t{});
+    case 256:
+      return as(int8_t{});
+    case 4:
+      return as(int16_t{});
+    case 512:
+      return as(uint16_t{});
+    case 8:
+      return as(int32_t{});
+    case 768:
+      return as(uint32_t{});
+    case 16:
+      return as(float{});
+    case 64:
+      return as(double{});
+    case 1024:
+      return as(int64_t{});
+    default:
+      return as(uint64_t{});
   }
 }
 }  // namespace
@@ -82,17 +103,23 @@ NiftiVolume read_nifti(const std::string& path) {
     swap = true;
   }
   if (std::memcmp(hdr.data() + kMagic, "n+1\0", 4) != 0)
-    throw InputError(path + ": not a single-file NIfTI-1 volume (magic is not \"n+1\"; .hdr/.img pairs and NIfTI-2 are not supported)");
+    throw InputError(path +
+                     ": not a single-file NIfTI-1 volume (magic is not \"n+1\"; .hdr/.img pairs "
+                     "and NIfTI-2 are not supported)");
   NiftiVolume v;
   const int ndim = get<int16_t>(hdr, kDim, swap);
   if (ndim < 1 || ndim > 4)
-    throw InputError(path + ": dim[0] = " + std::to_string(ndim) + ": only 1 to 4 dimensions are supported");
+    throw InputError(path + ": dim[0] = " + std::to_string(ndim) +
+                     ": only 1 to 4 dimensions are supported");
   uint64_t count = 1;
   for (int i = 0; i < 4; ++i) {
     const int d = i < ndim ? get<int16_t>(hdr, kDim + 2 * static_cast<size_t>(i + 1), swap) : 1;
-    if (d < 1) throw InputError(path + ": dim[" + std::to_string(i + 1) + "] = " + std::to_string(d) + ": must be >= 1");
+    if (d < 1)
+      throw InputError(path + ": dim[" + std::to_string(i + 1) + "] = " + std::to_string(d) +
+                       ": must be >= 1");
     v.dim[static_cast<size_t>(i)] = d;
-    v.pixdim[static_cast<size_t>(i)] = get<float>(hdr, kPixdim + 4 * static_cast<size_t>(i + 1), swap);
+    v.pixdim[static_cast<size_t>(i)] =
+        get<float>(hdr, kPixdim + 4 * static_cast<size_t>(i + 1), swap);
     count *= static_cast<uint64_t>(d);
   }
   if (count > (uint64_t{1} << 28))
@@ -104,22 +131,25 @@ NiftiVolume read_nifti(const std::string& path) {
                      " is not supported (integers of 8 to 64 bits, float32, float64)");
   const double offset = get<float>(hdr, kVoxOffset, swap);
   if (!(offset >= static_cast<double>(kHeader)) || offset > 1e9)
-    throw InputError(path + ": vox_offset " + std::to_string(offset) + " is not a valid data offset");
+    throw InputError(path + ": vox_offset " + std::to_string(offset) +
+                     " is not a valid data offset");
   in.seekg(0, std::ios::end);
   const uint64_t size = static_cast<uint64_t>(in.tellg());
   const uint64_t need = static_cast<uint64_t>(offset) + count * static_cast<uint64_t>(nb);
   if (size < need)
-    throw InputError(path + ": truncated: the header promises " + std::to_string(need) + " bytes, the file has " +
-                     std::to_string(size));
+    throw InputError(path + ": truncated: the header promises " + std::to_string(need) +
+                     " bytes, the file has " + std::to_string(size));
   std::vector<char> raw(count * static_cast<uint64_t>(nb));
   in.seekg(static_cast<std::streamoff>(offset));
-  if (!in.read(raw.data(), static_cast<std::streamsize>(raw.size()))) throw InputError(path + ": cannot read the data");
+  if (!in.read(raw.data(), static_cast<std::streamsize>(raw.size())))
+    throw InputError(path + ": cannot read the data");
   double slope = get<float>(hdr, kSclSlope, swap), inter = get<float>(hdr, kSclInter, swap);
   if (!(slope != 0) || !std::isfinite(slope)) slope = 1, inter = 0;  // 0: no scaling (standard)
   if (!std::isfinite(inter)) inter = 0;
   v.data.resize(count);
   for (uint64_t i = 0; i < count; ++i)
-    v.data[i] = static_cast<float>(slope * value_at(raw.data() + i * static_cast<uint64_t>(nb), v.datatype, swap) + inter);
+    v.data[i] = static_cast<float>(
+        slope * value_at(raw.data() + i * static_cast<uint64_t>(nb), v.datatype, swap) + inter);
   return v;
 }
 
@@ -157,7 +187,8 @@ void write_nifti_float32(const std::string& path, const std::array<int, 4>& dim,
   write_atomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::binary);
     out.write(hdr.data(), static_cast<std::streamsize>(hdr.size()));
-    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(count * sizeof(float)));
+    out.write(reinterpret_cast<const char*>(data),
+              static_cast<std::streamsize>(count * sizeof(float)));
     if (!out) throw RuntimeError("cannot write '" + path + "'");
   });
 }

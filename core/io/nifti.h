@@ -12,7 +12,8 @@ struct NiftiVolume {
   std::array<int, 4> dim{1, 1, 1, 1};        ///< nx, ny, nz, nt (1 when absent)
   std::array<double, 4> pixdim{1, 1, 1, 1};  ///< voxel size (mm when xyzt_units says so) and dt
   int datatype = 0;                          ///< NIfTI datatype code of the file
-  std::vector<float> data;                   ///< values as float32, x fastest (NIfTI order), scaled by scl_slope/inter
+  std::vector<float>
+      data;  ///< values as float32, x fastest (NIfTI order), scaled by scl_slope/inter
 };
 
 /// Reads a .nii file (either byte order; integer and float datatypes). Throws InputError naming

@@ -28,12 +28,15 @@ nlohmann::json summary_json(const Setup& s, const Result& r) {
   const size_t T = static_cast<size_t>(r.gates), D = s.detectors.size();
   auto num = [](double x) { return std::isfinite(x) ? J(x) : J(nullptr); };
   for (size_t d = 0; d < D; ++d) {
-    std::vector<std::vector<double>> batches(static_cast<size_t>(r.batches), std::vector<double>(T));
+    std::vector<std::vector<double>> batches(static_cast<size_t>(r.batches),
+                                             std::vector<double>(T));
     for (size_t k = 0; k < batches.size(); ++k)
       for (size_t g = 0; g < T; ++g) batches[k][g] = r.tpsf_batches[(k * D + d) * T + g];
     const PulseStats ps = pulse_stats(s.time, batches);
     auto stat = [&](const PulseStat& st) {
-      return J{{"value_ps", num(st.value)}, {"jackknife_se_ps", num(st.se)}, {"ci95_ps", {num(st.ci_lo), num(st.ci_hi)}}};
+      return J{{"value_ps", num(st.value)},
+               {"jackknife_se_ps", num(st.se)},
+               {"ci95_ps", {num(st.ci_lo), num(st.ci_hi)}}};
     };
     J pulse = ps.defined ? J{{"mean_time", stat(ps.mean)},
                              {"rms_width", stat(ps.rms)},
@@ -42,7 +45,8 @@ nlohmann::json summary_json(const Setup& s, const Result& r) {
                              {"width_noise_limited", ps.width_noise_limited}}
                          : J(nullptr);
     dets.push_back({{"index", d},
-                    {"position_mm", {s.detectors[d].center.x, s.detectors[d].center.y, s.detectors[d].center.z}},
+                    {"position_mm",
+                     {s.detectors[d].center.x, s.detectors[d].center.y, s.detectors[d].center.z}},
                     {"radius_mm", s.detectors[d].radius},
                     {"na", s.detectors[d].na},
                     {"detected_fraction", r.detected_weight[d] / N},
@@ -62,7 +66,9 @@ nlohmann::json summary_json(const Setup& s, const Result& r) {
              {"missed_tissue", b.missed / N},
              {"alive_at_window_end", b.alive / N},
              {"residual", b.residual() / N},
-             {"note", "fractions of the launched energy; launched = absorbed + escaped + specular + missed + alive"}}},
+             {"note",
+              "fractions of the launched energy; launched = absorbed + escaped + specular + missed "
+              "+ alive"}}},
            {"detectors", dets},
            {"detected_photons_recorded", r.detected.size()},
            {"detected_photons_dropped", r.detected.dropped},
@@ -71,7 +77,8 @@ nlohmann::json summary_json(const Setup& s, const Result& r) {
             {{"seconds", r.seconds},
              {"threads", r.threads},
              {"photons_per_ms", ms > 0 ? N / ms : 0.0},
-             {"scattering_events_per_second", r.seconds > 0 ? static_cast<double>(r.scatterings) / r.seconds : 0.0}}},
+             {"scattering_events_per_second",
+              r.seconds > 0 ? static_cast<double>(r.scatterings) / r.seconds : 0.0}}},
            {"batches", r.batches},
            {"fixed_point_quantum_mm", r.fixed_point_quantum}};
 }
@@ -93,7 +100,8 @@ std::vector<std::string> write_outputs(const std::string& dir, const Setup& s, c
     const float per_ps = static_cast<float>(1.0 / s.time.bin_width_ps);
     for (size_t i = 0; i < buf.size(); ++i) buf[i] = r.fluence[i] * per_ps;
     write_npy_float32(path("fluence_rate.npy"), shape, buf.data());
-    if (s.fluence_stderr) write_npy_float32(path("fluence_stderr.npy"), shape, r.fluence_err.data());
+    if (s.fluence_stderr)
+      write_npy_float32(path("fluence_stderr.npy"), shape, r.fluence_err.data());
     // NIfTI order: x fastest, then y, z, t.
     const size_t nx = shape[0], ny = shape[1], nz = shape[2];
     for (size_t i = 0; i < nx; ++i)
@@ -111,7 +119,8 @@ std::vector<std::string> write_outputs(const std::string& dir, const Setup& s, c
     std::vector<float> tpsf(r.tpsf.begin(), r.tpsf.end());
     write_npy_float32(path("tpsf.npy"), {D, T}, tpsf.data());
     std::string csv = "t_ps";
-    for (size_t d = 0; d < D; ++d) csv += ",exitance_" + std::to_string(d) + ",stderr_" + std::to_string(d);
+    for (size_t d = 0; d < D; ++d)
+      csv += ",exitance_" + std::to_string(d) + ",stderr_" + std::to_string(d);
     csv += "\n";
     for (size_t g = 0; g < T; ++g) {
       char buf[64];
@@ -140,9 +149,10 @@ std::vector<std::string> write_outputs(const std::string& dir, const Setup& s, c
   }
   if (s.faces)
     for (size_t f = 0; f < 6; ++f)
-      write_npy_float32(path(std::string("exitance_") + kFaceNames[f] + ".npy"),
-                        {static_cast<size_t>(r.face_shape[f][0]), static_cast<size_t>(r.face_shape[f][1]), T},
-                        r.face_exitance[f].data());
+      write_npy_float32(
+          path(std::string("exitance_") + kFaceNames[f] + ".npy"),
+          {static_cast<size_t>(r.face_shape[f][0]), static_cast<size_t>(r.face_shape[f][1]), T},
+          r.face_exitance[f].data());
   const nlohmann::json summary = summary_json(s, r);
   write_text_atomically(path("summary.json"), summary.dump(2) + "\n");
   files.push_back("render.json");

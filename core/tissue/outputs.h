@@ -15,7 +15,7 @@ nlohmann::json summary_json(const Setup& setup, const Result& result);
 /// Writes every output into `dir` (each file atomically); `record` (version, command, scene...)
 /// goes into render.json together with the summary and the list of files ("outputs"). Returns
 /// the files.
-std::vector<std::string> write_outputs(const std::string& dir, const Setup& setup, const Result& result,
-                                       nlohmann::json record);
+std::vector<std::string> write_outputs(const std::string& dir, const Setup& setup,
+                                       const Result& result, nlohmann::json record);
 
 }  // namespace femto::tissue

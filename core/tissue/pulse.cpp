@@ -78,14 +78,17 @@ PulseStats pulse_stats(const TimeAxis& axis, const std::vector<std::vector<doubl
   auto gate_se = [&](size_t g) {
     double m = all[g] / static_cast<double>(B), ss = 0;
     for (const auto& b : batches) ss += (b[g] - m) * (b[g] - m);
-    return B > 1 ? std::sqrt(ss / (static_cast<double>(B) - 1)) * std::sqrt(static_cast<double>(B)) : 0.0;
+    return B > 1 ? std::sqrt(ss / (static_cast<double>(B) - 1)) * std::sqrt(static_cast<double>(B))
+                 : 0.0;
   };
   const double neighbour = std::max(j > 0 ? all[j - 1] : 0.0, j + 1 < T ? all[j + 1] : 0.0);
-  const double se_diff = std::hypot(gate_se(j), j > 0 && (j + 1 >= T || all[j - 1] >= all[j + 1]) ? gate_se(j - 1)
-                                                                     : (j + 1 < T ? gate_se(j + 1) : 0.0));
+  const double se_diff = std::hypot(gate_se(j), j > 0 && (j + 1 >= T || all[j - 1] >= all[j + 1])
+                                                    ? gate_se(j - 1)
+                                                    : (j + 1 < T ? gate_se(j + 1) : 0.0));
   // Decided by noise: the peak gate does not stand out from its larger neighbour by 2 standard
   // errors, or the replicates move the peak by more than a gate.
-  out.peak_noise_limited = B < 2 || all[j] - neighbour < 2 * se_diff || !(q * out.peak.se <= axis.bin_width_ps);
+  out.peak_noise_limited =
+      B < 2 || all[j] - neighbour < 2 * se_diff || !(q * out.peak.se <= axis.bin_width_ps);
   out.width_noise_limited = B < 2 || !(std::max(out.mean.se, out.rms.se) <= 0.1 * out.rms.value);
   return out;
 }

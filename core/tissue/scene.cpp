@@ -17,8 +17,9 @@ namespace {
 using Json = nlohmann::json;
 using Keys = std::vector<std::string>;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kMaxCells = 268435456.0;    // 2^28 label voxels (512 MiB of labels)
-constexpr double kMaxTallyCells = 68719476736.0;  // 2^36 fluence cells x gates: bounds every size computation
+constexpr double kMaxCells = 268435456.0;  // 2^28 label voxels (512 MiB of labels)
+constexpr double kMaxTallyCells =
+    68719476736.0;  // 2^36 fluence cells x gates: bounds every size computation
 constexpr int kMaxLabel = 65535;
 constexpr int kMaxNesting = 64;  // JSON depth, as for camera scenes
 
@@ -36,13 +37,15 @@ std::string show(const Json& v) {
 // Reads one JSON object strictly: every key must be used, every value checked.
 class Reader {
  public:
-  Reader(std::string source, std::string base) : source_(std::move(source)), base_(std::move(base)) {}
+  Reader(std::string source, std::string base)
+      : source_(std::move(source)), base_(std::move(base)) {}
 
   std::string where(const std::string& path) const { return clip(source_, 200) + ": " + path; }
   [[noreturn]] void fail(const std::string& path, const std::string& problem) const {
     throw InputError(clip(source_, 200) + ": " + path + ": " + problem);
   }
-  [[noreturn]] void fail(const std::string& path, const std::string& problem, const Json& got) const {
+  [[noreturn]] void fail(const std::string& path, const std::string& problem,
+                         const Json& got) const {
     fail(path, problem + " (got " + show(got) + ")");
   }
 
@@ -63,11 +66,12 @@ class Reader {
                 bool hi_open = false) const {
     if (!j.is_number()) fail(path, "must be a number", j);
     const double x = j.get<double>();
-    const bool ok = std::isfinite(x) && (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
+    const bool ok =
+        std::isfinite(x) && (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
     if (!ok) {
       std::string range = hi == kInf ? std::string(lo_open ? "must be > " : "must be >= ") + fmt(lo)
-                                     : std::string("must be in ") + (lo_open ? "(" : "[") + fmt(lo) +
-                                           ", " + fmt(hi) + (hi_open ? ")" : "]");
+                                     : std::string("must be in ") + (lo_open ? "(" : "[") +
+                                           fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]");
       fail(path, range, j);
     }
     return x;
@@ -80,7 +84,8 @@ class Reader {
   Vec3 vec3(const Json& j, const std::string& path, bool nonzero = false) const {
     if (!j.is_array() || j.size() != 3) fail(path, "must be [x, y, z]", j);
     Vec3 v;
-    for (int i = 0; i < 3; ++i) v[i] = number(j[static_cast<size_t>(i)], path + "/" + std::to_string(i), -1e9, 1e9);
+    for (int i = 0; i < 3; ++i)
+      v[i] = number(j[static_cast<size_t>(i)], path + "/" + std::to_string(i), -1e9, 1e9);
     if (nonzero && !(length(v) > 0)) fail(path, "must not be the zero vector", j);
     return v;
   }
@@ -122,12 +127,14 @@ Json parse_strict(const std::string& text, const std::string& source) {
   const Json::parser_callback_t cb = [&](int depth, Json::parse_event_t ev, Json& parsed) {
     if ((ev == Json::parse_event_t::object_start || ev == Json::parse_event_t::array_start) &&
         depth >= kMaxNesting)
-      throw InputError(clip(source, 200) + ": values are nested more than " + std::to_string(kMaxNesting) +
+      throw InputError(clip(source, 200) + ": values are nested more than " +
+                       std::to_string(kMaxNesting) +
                        " levels deep; a tissue scene needs far fewer");
     if (ev == Json::parse_event_t::object_start) keys.emplace_back();
     if (ev == Json::parse_event_t::object_end) keys.pop_back();
     if (ev == Json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second)
-      throw InputError(clip(source, 200) + ": duplicate key '" + clip(parsed.get<std::string>()) + "'");
+      throw InputError(clip(source, 200) + ": duplicate key '" + clip(parsed.get<std::string>()) +
+                       "'");
     return true;
   };
   try {
@@ -141,8 +148,10 @@ Json parse_strict(const std::string& text, const std::string& source) {
 
 void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s) {
   rd.object(j, P, {"shape", "fill", "voxel", "origin", "nifti", "vdb", "grid"});
-  const int sources = (j.contains("fill") ? 1 : 0) + (j.contains("nifti") ? 1 : 0) + (j.contains("vdb") ? 1 : 0);
-  if (sources != 1) rd.fail(P, "needs exactly one of \"fill\" (with \"shape\"), \"nifti\" or \"vdb\"", j);
+  const int sources =
+      (j.contains("fill") ? 1 : 0) + (j.contains("nifti") ? 1 : 0) + (j.contains("vdb") ? 1 : 0);
+  if (sources != 1)
+    rd.fail(P, "needs exactly one of \"fill\" (with \"shape\"), \"nifti\" or \"vdb\"", j);
   LabelVolume& v = s.volume;
   std::vector<uint16_t>& labels = v.labels;
   if (j.contains("fill")) {
@@ -151,7 +160,8 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
     const auto n = rd.ints3(j["shape"], P + "/shape", 1, 100000);
     const int label = static_cast<int>(rd.integer(j["fill"], P + "/fill", 1, kMaxLabel));
     double cells = 1;
-    for (int a = 0; a < 3; ++a) v.n[a] = n[static_cast<size_t>(a)], cells *= n[static_cast<size_t>(a)];
+    for (int a = 0; a < 3; ++a)
+      v.n[a] = n[static_cast<size_t>(a)], cells *= n[static_cast<size_t>(a)];
     if (cells > kMaxCells) rd.fail(P + "/shape", "more than 2^28 voxels", j["shape"]);
     labels.assign(static_cast<size_t>(cells), static_cast<uint16_t>(label));
   } else if (j.contains("nifti")) {
@@ -164,15 +174,18 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
     } catch (const InputError& e) {
       rd.fail(P + "/nifti", e.what());
     }
-    if (nv.dim[3] != 1) rd.fail(P + "/nifti", path + ": a label volume has 3 dimensions (dim[4] = " + std::to_string(nv.dim[3]) + ")");
+    if (nv.dim[3] != 1)
+      rd.fail(P + "/nifti", path + ": a label volume has 3 dimensions (dim[4] = " +
+                                std::to_string(nv.dim[3]) + ")");
     double cells = 1;
     for (int a = 0; a < 3; ++a) v.n[a] = nv.dim[static_cast<size_t>(a)], cells *= v.n[a];
     if (cells > kMaxCells) rd.fail(P + "/nifti", path + ": more than 2^28 voxels");
     if (!j.contains("voxel")) {
       const auto& pd = nv.pixdim;
-      if (!(pd[0] > 0) || std::abs(pd[0] - pd[1]) > 1e-6 * pd[0] || std::abs(pd[0] - pd[2]) > 1e-6 * pd[0])
-        rd.fail(P + "/nifti", path + ": voxels are " + fmt(pd[0]) + " x " + fmt(pd[1]) + " x " + fmt(pd[2]) +
-                                  " mm; cubic voxels are needed (or give \"voxel\")");
+      if (!(pd[0] > 0) || std::abs(pd[0] - pd[1]) > 1e-6 * pd[0] ||
+          std::abs(pd[0] - pd[2]) > 1e-6 * pd[0])
+        rd.fail(P + "/nifti", path + ": voxels are " + fmt(pd[0]) + " x " + fmt(pd[1]) + " x " +
+                                  fmt(pd[2]) + " mm; cubic voxels are needed (or give \"voxel\")");
       v.voxel = pd[0];
     }
     // NIfTI is x fastest; the label grid is z fastest.
@@ -182,8 +195,9 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
         for (int k = 0; k < v.n[2]; ++k) {
           const double x = nv.data[(static_cast<size_t>(k) * v.n[1] + jj) * v.n[0] + i];
           if (x != std::floor(x) || x < 0 || x > kMaxLabel)
-            rd.fail(P + "/nifti", path + ": voxel (" + std::to_string(i) + ", " + std::to_string(jj) + ", " +
-                                      std::to_string(k) + ") holds " + fmt(x) + "; labels are whole numbers 0 to 65535");
+            rd.fail(P + "/nifti", path + ": voxel (" + std::to_string(i) + ", " +
+                                      std::to_string(jj) + ", " + std::to_string(k) + ") holds " +
+                                      fmt(x) + "; labels are whole numbers 0 to 65535");
           labels[v.index(i, jj, k)] = static_cast<uint16_t>(x);
         }
   } else {
@@ -197,7 +211,8 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
     labels.resize(d.labels.size());
     for (size_t i = 0; i < labels.size(); ++i) {
       if (d.labels[i] < 0 || d.labels[i] > kMaxLabel)
-        rd.fail(P + "/vdb", path + ": label " + std::to_string(d.labels[i]) + " is outside 0 to 65535");
+        rd.fail(P + "/vdb",
+                path + ": label " + std::to_string(d.labels[i]) + " is outside 0 to 65535");
       labels[i] = static_cast<uint16_t>(d.labels[i]);
     }
   }
@@ -205,8 +220,10 @@ void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s
   if (j.contains("origin")) v.origin = rd.vec3(j["origin"], P + "/origin");
 }
 
-void read_labels(const Reader& rd, const Json& j, const std::string& P, double outside_n, Setup& s) {
-  if (!j.is_array() || j.empty()) rd.fail(P, "must be a non-empty array of {\"label\", \"mu_a\", \"mu_s\", \"g\", \"n\"}", j);
+void read_labels(const Reader& rd, const Json& j, const std::string& P, double outside_n,
+                 Setup& s) {
+  if (!j.is_array() || j.empty())
+    rd.fail(P, "must be a non-empty array of {\"label\", \"mu_a\", \"mu_s\", \"g\", \"n\"}", j);
   std::vector<bool> given;
   std::vector<TissueOptics>& optics = s.volume.optics;
   for (size_t i = 0; i < j.size(); ++i) {
@@ -230,15 +247,19 @@ void read_labels(const Reader& rd, const Json& j, const std::string& P, double o
   for (uint16_t l : s.volume.labels) seen[l] = true;
   for (size_t l = 1; l < seen.size(); ++l)
     if (seen[l] && (l >= given.size() || !given[l]))
-      rd.fail(P, "label " + std::to_string(l) + " occurs in the volume but has no optical properties here");
+      rd.fail(P, "label " + std::to_string(l) +
+                     " occurs in the volume but has no optical properties here");
 }
 
 void read_source(const Reader& rd, const Json& j, const std::string& P, Source& src) {
   rd.object(j, P, {"type", "position", "direction", "waist", "radius", "pulse", "specular"});
   if (!j.contains("type")) rd.fail(P + "/type", "required");
-  const std::string type = rd.string(j["type"], P + "/type", {"pencil", "gaussian", "disk", "isotropic"});
-  src.type = type == "pencil" ? Source::Type::Pencil : type == "gaussian" ? Source::Type::Gaussian
-           : type == "disk"   ? Source::Type::Disk   : Source::Type::Isotropic;
+  const std::string type =
+      rd.string(j["type"], P + "/type", {"pencil", "gaussian", "disk", "isotropic"});
+  src.type = type == "pencil"     ? Source::Type::Pencil
+             : type == "gaussian" ? Source::Type::Gaussian
+             : type == "disk"     ? Source::Type::Disk
+                                  : Source::Type::Isotropic;
   if (!j.contains("position")) rd.fail(P + "/position", "required");
   src.position = rd.vec3(j["position"], P + "/position");
   if (src.type == Source::Type::Isotropic) {
@@ -248,7 +269,8 @@ void read_source(const Reader& rd, const Json& j, const std::string& P, Source& 
     src.direction = normalize(rd.vec3(j["direction"], P + "/direction", true));
   }
   if (src.type == Source::Type::Gaussian) {
-    if (!j.contains("waist")) rd.fail(P + "/waist", "required for a gaussian source (1/e^2 radius, mm)");
+    if (!j.contains("waist"))
+      rd.fail(P + "/waist", "required for a gaussian source (1/e^2 radius, mm)");
     src.waist = rd.number(j["waist"], P + "/waist", 0, 1e6, true);
   } else if (j.contains("waist")) {
     rd.fail(P + "/waist", "applies to gaussian sources only");
@@ -262,7 +284,8 @@ void read_source(const Reader& rd, const Json& j, const std::string& P, Source& 
   if (j.contains("pulse")) {
     const Json& pl = rd.object(j["pulse"], P + "/pulse", {"fwhm", "offset"});
     if (pl.contains("fwhm")) src.fwhm_ps = rd.number(pl["fwhm"], P + "/pulse/fwhm", 0, 1e9);
-    if (pl.contains("offset")) src.offset_ps = rd.number(pl["offset"], P + "/pulse/offset", -1e9, 1e9);
+    if (pl.contains("offset"))
+      src.offset_ps = rd.number(pl["offset"], P + "/pulse/offset", -1e9, 1e9);
   }
   if (j.contains("specular")) src.specular = rd.boolean(j["specular"], P + "/specular");
 }
@@ -285,32 +308,38 @@ bool is_tissue_scene(const std::string& text) {
   }
 }
 
-Setup load_tissue_scene(const std::string& text, const std::string& source, const std::string& base_dir) {
+Setup load_tissue_scene(const std::string& text, const std::string& source,
+                        const std::string& base_dir) {
   const Reader rd(source, base_dir);
   const Json root = parse_strict(text, source);
   rd.object(root, "", {"tissue"});
   const std::string P = "/tissue";
-  const Json& t = rd.object(root["tissue"], P,
-                            {"volume", "labels", "outside_n", "boundary", "absorption", "source", "time",
-                             "fluence", "faces", "detectors", "detected_photons", "photons", "seed", "batches"});
+  const Json& t = rd.object(
+      root["tissue"], P,
+      {"volume", "labels", "outside_n", "boundary", "absorption", "source", "time", "fluence",
+       "faces", "detectors", "detected_photons", "photons", "seed", "batches"});
   for (const char* k : {"volume", "labels", "source", "time"})
     if (!t.contains(k)) rd.fail(P + "/" + k, "required");
   Setup s;
   read_volume(rd, t["volume"], P + "/volume", s);
-  const double outside_n = t.contains("outside_n") ? rd.number(t["outside_n"], P + "/outside_n", 1, 10) : 1.0;
+  const double outside_n =
+      t.contains("outside_n") ? rd.number(t["outside_n"], P + "/outside_n", 1, 10) : 1.0;
   s.volume.optics.assign(1, TissueOptics{});
   read_labels(rd, t["labels"], P + "/labels", outside_n, s);
   if (t.contains("boundary"))
     s.fresnel = rd.string(t["boundary"], P + "/boundary", {"fresnel", "matched"}) == "fresnel";
   if (t.contains("absorption"))
-    s.absorption = rd.string(t["absorption"], P + "/absorption", {"weighted", "analog"}) == "weighted"
-                       ? Absorption::Weighted : Absorption::Analog;
+    s.absorption =
+        rd.string(t["absorption"], P + "/absorption", {"weighted", "analog"}) == "weighted"
+            ? Absorption::Weighted
+            : Absorption::Analog;
   read_source(rd, t["source"], P + "/source", s.source);
 
   const Json& tm = rd.object(t["time"], P + "/time", {"t_start", "bin_width", "bins"});
   for (const char* k : {"bin_width", "bins"})
     if (!tm.contains(k)) rd.fail(P + "/time/" + k, "required");
-  if (tm.contains("t_start")) s.time.t_start_ps = rd.number(tm["t_start"], P + "/time/t_start", -1e9, 1e9);
+  if (tm.contains("t_start"))
+    s.time.t_start_ps = rd.number(tm["t_start"], P + "/time/t_start", -1e9, 1e9);
   s.time.bin_width_ps = rd.number(tm["bin_width"], P + "/time/bin_width", 1e-6, 1e9);
   s.time.bins = static_cast<int>(rd.integer(tm["bins"], P + "/time/bins", 1, 100000));
 
@@ -334,16 +363,19 @@ Setup load_tissue_scene(const std::string& text, const std::string& source, cons
       if (f.contains("size")) {
         s.fluence_grid.size = rd.vec3(f["size"], P + "/fluence/size");
         for (int a = 0; a < 3; ++a)
-          if (!(s.fluence_grid.size[a] > 0)) rd.fail(P + "/fluence/size", "every extent must be > 0", f["size"]);
+          if (!(s.fluence_grid.size[a] > 0))
+            rd.fail(P + "/fluence/size", "every extent must be > 0", f["size"]);
       }
       if (f.contains("stderr")) s.fluence_stderr = rd.boolean(f["stderr"], P + "/fluence/stderr");
     }
   }
   if (s.fluence) {
-    const double cells = static_cast<double>(s.fluence_grid.n[0]) * s.fluence_grid.n[1] * s.fluence_grid.n[2];
+    const double cells =
+        static_cast<double>(s.fluence_grid.n[0]) * s.fluence_grid.n[1] * s.fluence_grid.n[2];
     if (cells * s.time.bins > kMaxTallyCells)
-      rd.fail(P + "/fluence", "a fluence volume of " + fmt(cells) + " voxels x " + std::to_string(s.time.bins) +
-                                  " gates is above the limit of 2^36 values; lower its resolution or the gates");
+      rd.fail(P + "/fluence",
+              "a fluence volume of " + fmt(cells) + " voxels x " + std::to_string(s.time.bins) +
+                  " gates is above the limit of 2^36 values; lower its resolution or the gates");
   }
   if (t.contains("faces")) s.faces = rd.boolean(t["faces"], P + "/faces");
   if (t.contains("detectors")) {
@@ -364,13 +396,19 @@ Setup load_tissue_scene(const std::string& text, const std::string& source, cons
   if (t.contains("detected_photons")) {
     const Json& d = rd.object(t["detected_photons"], P + "/detected_photons", {"save", "max"});
     if (d.contains("save")) s.save_detected = rd.boolean(d["save"], P + "/detected_photons/save");
-    if (d.contains("max")) s.max_detected = static_cast<uint64_t>(rd.integer(d["max"], P + "/detected_photons/max", 0, 1e9));
+    if (d.contains("max"))
+      s.max_detected =
+          static_cast<uint64_t>(rd.integer(d["max"], P + "/detected_photons/max", 0, 1e9));
   }
-  if (t.contains("photons")) s.photons = static_cast<uint64_t>(rd.integer(t["photons"], P + "/photons", 1, 1e12));
-  if (t.contains("seed")) s.seed = static_cast<uint64_t>(rd.integer(t["seed"], P + "/seed", 0, 9007199254740992.0));
-  if (t.contains("batches")) s.batches = static_cast<int>(rd.integer(t["batches"], P + "/batches", 1, 1000));
+  if (t.contains("photons"))
+    s.photons = static_cast<uint64_t>(rd.integer(t["photons"], P + "/photons", 1, 1e12));
+  if (t.contains("seed"))
+    s.seed = static_cast<uint64_t>(rd.integer(t["seed"], P + "/seed", 0, 9007199254740992.0));
+  if (t.contains("batches"))
+    s.batches = static_cast<int>(rd.integer(t["batches"], P + "/batches", 1, 1000));
   if (s.fluence_stderr && s.batches < 2)
-    rd.fail(P + "/batches", "standard errors (/tissue/fluence/stderr) need at least 2 batches", t["batches"]);
+    rd.fail(P + "/batches", "standard errors (/tissue/fluence/stderr) need at least 2 batches",
+            t["batches"]);
   return s;
 }
 

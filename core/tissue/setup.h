@@ -57,7 +57,7 @@ struct Setup {
   bool fluence_stderr = false;  ///< per-voxel standard errors from the batches
   bool faces = false;           ///< exitance images of the six faces of the volume over time
   std::vector<Detector> detectors;
-  bool save_detected = true;      ///< per detected photon: partial paths, scatterings, weight, time
+  bool save_detected = true;  ///< per detected photon: partial paths, scatterings, weight, time
   uint64_t max_detected = 10000000;  ///< records kept at most (the TPSF counts every photon)
   uint64_t photons = 1000000;
   uint64_t seed = 1;

@@ -60,9 +60,11 @@ struct ThreadSums {
 // The fixed-point scale 2^k: no cell of any sum can overflow 2^63 (a photon's track length is at
 // most c times the window; every launched photon has weight <= 1).
 int fixed_point_bits(const Setup& s) {
-  const double t_span = s.time.t_end_ps() - std::min(s.time.t_start_ps, s.source.offset_ps - 8 * s.source.sigma_ps());
+  const double t_span =
+      s.time.t_end_ps() - std::min(s.time.t_start_ps, s.source.offset_ps - 8 * s.source.sigma_ps());
   const double max_track = kSpeedOfLight * std::max(t_span, s.time.bin_width_ps) + 1.0;
-  const double headroom = 9.2e18 / (static_cast<double>(std::max<uint64_t>(s.photons, 1)) * max_track);
+  const double headroom =
+      9.2e18 / (static_cast<double>(std::max<uint64_t>(s.photons, 1)) * max_track);
   return std::clamp(static_cast<int>(std::floor(std::log2(headroom))), 0, 40);
 }
 
@@ -70,8 +72,12 @@ int fixed_point_bits(const Setup& s) {
 class Tally {
  public:
   Tally(const Setup& s, ThreadSums& sums, double scale)
-      : s_(s), sums_(sums), scale_(scale), gates_(s.time.bins),
-        same_grid_(s.fluence && same_grid(s)), ppath_(s.volume.optics.size(), 0.0) {
+      : s_(s),
+        sums_(sums),
+        scale_(scale),
+        gates_(s.time.bins),
+        same_grid_(s.fluence && same_grid(s)),
+        ppath_(s.volume.optics.size(), 0.0) {
     const FluenceGrid& fg = s.fluence_grid;
     h_ = fg.spacing();
     cells_ = fg.cells();
@@ -147,7 +153,8 @@ class Tally {
     const size_t stride = cells_;
     for (double t = lo; t < hi && j < gates_; ++j) {
       const double te = j == gates_ - 1 ? hi : std::min(hi, ax.bin_start_ps(j + 1));
-      if (te > t) add(c + j * stride, seg.w0 * seg.v * exp_integral(seg.k, t - seg.t0, te - seg.t0));
+      if (te > t)
+        add(c + j * stride, seg.w0 * seg.v * exp_integral(seg.k, t - seg.t0, te - seg.t0));
       t = std::max(t, te);
     }
   }
@@ -332,8 +339,9 @@ bool launch(const Setup& s, const LabelSpace& space, Rng& rng, Photon& p, double
   if (src.type == Source::Type::Gaussian || src.type == Source::Type::Disk) {
     const double u = rng.uniform(), phi = 2.0 * kPi * rng.uniform();
     // Gaussian: intensity exp(-2 r^2 / w^2) (w: 1/e^2 radius); disk: uniform in area.
-    const double r = src.type == Source::Type::Gaussian ? src.waist * std::sqrt(-0.5 * std::log1p(-u))
-                                                        : src.radius * std::sqrt(u);
+    const double r = src.type == Source::Type::Gaussian
+                         ? src.waist * std::sqrt(-0.5 * std::log1p(-u))
+                         : src.radius * std::sqrt(u);
     p.x += Frame(src.direction).to_world({r * std::cos(phi), r * std::sin(phi), 0.0});
   } else if (src.type == Source::Type::Isotropic) {
     const double u1 = rng.uniform(), u2 = rng.uniform();
@@ -407,7 +415,8 @@ uint64_t memory_bytes(const Setup& s, int threads) {
     for (int a = 0; a < 3; ++a)
       faces += 2 * static_cast<uint64_t>(s.volume.n[(a + 1) % 3]) * s.volume.n[(a + 2) % 3] * gates;
   // Integer sums per thread and in total; float results; double sums of squares for errors.
-  uint64_t bytes = (volume + faces) * 8 * (static_cast<uint64_t>(threads) + 1) + (volume + faces) * 4;
+  uint64_t bytes =
+      (volume + faces) * 8 * (static_cast<uint64_t>(threads) + 1) + (volume + faces) * 4;
   if (s.fluence_stderr) bytes += volume * (8 + 4);
   const uint64_t record = 8 * 2 + 4 * 2 + 8 * (s.volume.optics.size());
   if (!s.detectors.empty() && s.save_detected)
@@ -450,7 +459,8 @@ Result simulate(const Setup& s) {
   ChunkSums all;
   all.reset(labels, tpsf_size, ndet);
   all.records.labels = labels - 1;
-  const int batches = static_cast<int>(std::clamp<uint64_t>(static_cast<uint64_t>(s.batches), 1, s.photons));
+  const int batches =
+      static_cast<int>(std::clamp<uint64_t>(static_cast<uint64_t>(s.batches), 1, s.photons));
   r.tpsf_batches.assign(static_cast<size_t>(batches) * tpsf_size, 0.0);
   Progress progress(s.photons, "tissue", s.quiet, "photons");
   tbb::task_arena arena(threads);
@@ -472,7 +482,8 @@ Result simulate(const Setup& s) {
         progress.add(q1 - q0);
       });
     });
-    r.trace_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - trace_start).count();
+    r.trace_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - trace_start).count();
     // Chunk order: the reduction does not depend on which thread traced what.
     std::vector<double> batch_tpsf(tpsf_size, 0.0);
     for (ChunkSums& c : chunk) {
@@ -549,7 +560,8 @@ Result simulate(const Setup& s) {
     r.fluence.resize(volume_size);
     for (size_t g = 0; g < G; ++g)
       for (size_t c = 0; c < cells; ++c)
-        r.fluence[c * G + g] = static_cast<float>(static_cast<double>(total.fluence[g * cells + c]) * unit);
+        r.fluence[c * G + g] =
+            static_cast<float>(static_cast<double>(total.fluence[g * cells + c]) * unit);
     if (s.fluence_stderr) {
       r.fluence_err.resize(volume_size);
       const double B = batches, to_fluence = 1.0 / (scale * h.x * h.y * h.z);

@@ -18,10 +18,10 @@ struct Balance {
   double launched = 0;
   double absorbed = 0;
   std::array<double, 6> escaped_faces{};  ///< through the grid's faces -x, +x, -y, +y, -z, +z
-  double escaped_inside = 0;  ///< into label-0 voxels inside the grid
-  double specular = 0;        ///< reflected at the source's entry surface (source.specular)
-  double missed = 0;          ///< source photons that never reached tissue
-  double alive = 0;           ///< still in the tissue at the window end
+  double escaped_inside = 0;              ///< into label-0 voxels inside the grid
+  double specular = 0;  ///< reflected at the source's entry surface (source.specular)
+  double missed = 0;    ///< source photons that never reached tissue
+  double alive = 0;     ///< still in the tissue at the window end
   double escaped() const;
   /// launched - (absorbed + escaped + specular + missed + alive)
   double residual() const;
@@ -32,8 +32,8 @@ struct DetectedPhotons {
   int labels = 0;  ///< columns of `ppath`: labels 1 .. labels (label 0 is outside)
   std::vector<int32_t> detector, scatterings;
   std::vector<double> weight, time_ps;  ///< exit weight (launch weight 1) and exit time
-  std::vector<double> ppath;            ///< row-major (photon, label - 1): path length per label, mm
-  uint64_t dropped = 0;                 ///< detected beyond max_detected (counted in the TPSF)
+  std::vector<double> ppath;  ///< row-major (photon, label - 1): path length per label, mm
+  uint64_t dropped = 0;       ///< detected beyond max_detected (counted in the TPSF)
   size_t size() const { return weight.size(); }
 };
 
@@ -41,8 +41,8 @@ struct Result {
   int gates = 0, labels = 0;  ///< labels: size of the optics table (label 0 included)
   uint64_t photons = 0, scatterings = 0, segments = 0;
   int threads = 0, batches = 0;
-  double seconds = 0;        ///< the whole run
-  double trace_seconds = 0;  ///< tracing photons only (no allocation, reductions, results)
+  double seconds = 0;              ///< the whole run
+  double trace_seconds = 0;        ///< tracing photons only (no allocation, reductions, results)
   double fixed_point_quantum = 0;  ///< mm per unit of the integer volume sums
   /// Fluence per gate, 1/mm^2, index cell * gates + gate (cell = (i ny + j) nz + k): (X,Y,Z,T).
   std::vector<float> fluence, fluence_err;
@@ -70,7 +70,6 @@ Result simulate(const Setup& setup);
 /// Launches photon `p` from the source (position, direction, time) and moves it to the first
 /// tissue voxel. Returns false when it never reaches tissue. `specular` receives the weight
 /// reflected at the entry surface (source.specular), already removed from p.w.
-bool launch(const Setup& setup, const LabelSpace& space, Rng& rng, Photon& p,
-            double& specular);
+bool launch(const Setup& setup, const LabelSpace& space, Rng& rng, Photon& p, double& specular);
 
 }  // namespace femto::tissue

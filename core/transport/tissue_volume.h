@@ -20,15 +20,13 @@ struct TissueOptics {
 /// origin + voxel * [i, i + 1] x [j, j + 1] x [k, k + 1] (mm).
 struct LabelVolume {
   int n[3] = {0, 0, 0};
-  double voxel = 1;          ///< voxel edge, mm
-  Vec3 origin{0, 0, 0};      ///< world position of the grid's lower corner, mm
-  std::vector<uint16_t> labels;  ///< index (i * ny + j) * nz + k: x slowest, z fastest
+  double voxel = 1;                  ///< voxel edge, mm
+  Vec3 origin{0, 0, 0};              ///< world position of the grid's lower corner, mm
+  std::vector<uint16_t> labels;      ///< index (i * ny + j) * nz + k: x slowest, z fastest
   std::vector<TissueOptics> optics;  ///< per label; optics[0] is outside (only n is used)
 
   size_t cells() const { return static_cast<size_t>(n[0]) * n[1] * n[2]; }
-  size_t index(int i, int j, int k) const {
-    return (static_cast<size_t>(i) * n[1] + j) * n[2] + k;
-  }
+  size_t index(int i, int j, int k) const { return (static_cast<size_t>(i) * n[1] + j) * n[2] + k; }
   /// The label of voxel (i, j, k), 0 outside the grid.
   int label_at(int i, int j, int k) const {
     if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2]) return 0;

@@ -1,8 +1,9 @@
 #pragma once
 // The photon random walk of tissue optics and of `femto diffusion`, written once: a step moves a
 // photon along one straight piece (to its next scattering, to a voxel face where the label
-// changes, or to the window end) and describes that piece as a Segment for the tallies. What the space looks like is a template parameter (an unbounded homogeneous
-// medium, or a labelled voxel grid with Fresnel interfaces), so the hot loop has no virtual calls.
+// changes, or to the window end) and describes that piece as a Segment for the tallies. What the
+// space looks like is a template parameter (an unbounded homogeneous medium, or a labelled voxel
+// grid with Fresnel interfaces), so the hot loop has no virtual calls.
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -136,7 +137,8 @@ class LabelSpace {
     int next[3] = {p.cell[0], p.cell[1], p.cell[2]};
     next[axis] += step;
     const int label = vol_.label_at(next[0], next[1], next[2]);
-    const double n1 = optics_[static_cast<size_t>(p.label)].n, n2 = optics_[static_cast<size_t>(label)].n;
+    const double n1 = optics_[static_cast<size_t>(p.label)].n,
+                 n2 = optics_[static_cast<size_t>(label)].n;
     if (fresnel_ && n1 != n2) {
       const double cos_i = std::abs(p.d[axis]);
       const Fresnel fr = fresnel_dielectric(cos_i, n2 / n1);
