@@ -28,6 +28,21 @@ double Balance::residual() const {
 namespace {
 constexpr uint64_t kChunk = 1024;  // photons per task: the unit of ordered reduction
 
+// Fluence cells in 4 x 4 x 4 bricks (512 bytes of sums each): a photon's neighbouring voxels
+// share cache lines, where a row-major layout puts x neighbours a whole plane apart.
+struct BrickLayout {
+  int nb[3] = {0, 0, 0};
+  size_t slots = 0;  ///< bricks x 64, padded cells included
+  explicit BrickLayout(const int n[3]) {
+    for (int a = 0; a < 3; ++a) nb[a] = (n[a] + 3) / 4;
+    slots = static_cast<size_t>(nb[0]) * nb[1] * nb[2] * 64;
+  }
+  size_t index(int i, int j, int k) const {
+    const size_t brick = (static_cast<size_t>(i >> 2) * nb[1] + (j >> 2)) * nb[2] + (k >> 2);
+    return brick * 64 + static_cast<size_t>(((i & 3) << 4) | ((j & 3) << 2) | (k & 3));
+  }
+};
+
 double standard_normal(Rng& rng) {
   const double u1 = rng.uniform(), u2 = rng.uniform();
   return std::sqrt(-2.0 * std::log1p(-u1)) * std::cos(2.0 * kPi * u2);
@@ -72,7 +87,8 @@ int fixed_point_bits(const Setup& s) {
 class Tally {
  public:
   Tally(const Setup& s, ThreadSums& sums, double scale)
-      : s_(s),
+      : layout_(s.fluence_grid.n),
+        s_(s),
         sums_(sums),
         scale_(scale),
         gates_(s.time.bins),
@@ -80,7 +96,7 @@ class Tally {
         ppath_(s.volume.optics.size(), 0.0) {
     const FluenceGrid& fg = s.fluence_grid;
     h_ = fg.spacing();
-    cells_ = fg.cells();
+    cells_ = layout_.slots;
     plane_tolerance_ = 1e-6 * s.volume.voxel;
   }
   void begin(ChunkSums& out) {
@@ -125,7 +141,9 @@ class Tally {
     return true;
   }
 
-  uint64_t fixed(double x) const { return static_cast<uint64_t>(x * scale_ + 0.5); }
+  // Through int64 (values stay below 2^63 by the choice of scale): one instruction, where a
+  // direct double -> uint64 conversion needs a branch for the upper half.
+  uint64_t fixed(double x) const { return static_cast<uint64_t>(static_cast<int64_t>(x * scale_ + 0.5)); }
 
   // Consecutive deposits into the same entry (scatterings inside one voxel) are summed first:
   // fewer memory round trips and fewer roundings.
@@ -181,14 +199,18 @@ class Tally {
       const int j0 = ax.bin_of(seg.t0);
       const bool one_gate = j0 >= 0 && seg.t0 + seg.duration <= ax.bin_start_ps(j0 + 1);
       const size_t gate_offset = one_gate ? static_cast<size_t>(j0) * cells_ : 0;
-      VoxelDda dda(seg.x0, seg.d, seg.cell, vol.origin, Vec3(vol.voxel));
+      const VoxelDda dda(seg.x0, seg.d, seg.cell, vol.origin, Vec3(vol.voxel));
+      // One label: every voxel is in the grid.
+      double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
+      int cx = seg.cell[0], cy = seg.cell[1], cz = seg.cell[2];
       double sa = 0, ea = 1;
       while (true) {
-        const int a = dda.axis();
-        const bool last = dda.t_max[a] >= L;
-        const double sb = last ? L : dda.t_max[a];
+        const int a = tx < ty && tx < tz ? 0 : (!(tx < ty) && ty < tz ? 1 : 2);  // VoxelDda::axis()
+        const double t = a == 0 ? tx : (a == 1 ? ty : tz);
+        const bool last = t >= L;
+        const double sb = last ? L : t;
         if (sb > sa) {
-          const size_t c = vol.index(dda.cell[0], dda.cell[1], dda.cell[2]);
+          const size_t c = layout_.index(cx, cy, cz);
           if (one_gate) {
             double e;
             const double g = mean_decay(mu * (sb - sa), e);
@@ -201,7 +223,12 @@ class Tally {
         }
         if (last) break;
         sa = sb;
-        dda.advance(a);
+        if (a == 0)
+          cx += dda.step[0], tx += dda.t_delta[0];
+        else if (a == 1)
+          cy += dda.step[1], ty += dda.t_delta[1];
+        else
+          cz += dda.step[2], tz += dda.t_delta[2];
       }
       return;
     }
@@ -236,8 +263,7 @@ class Tally {
       const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
       const double e = std::min(next[a], s1);
       if (e > s) {
-        const size_t cell = (static_cast<size_t>(c[0]) * fg.n[1] + c[1]) * fg.n[2] + c[2];
-        deposit(seg, cell, s / seg.v, e / seg.v);
+        deposit(seg, layout_.index(c[0], c[1], c[2]), s / seg.v, e / seg.v);
       }
       s = std::max(s, e);
       c[a] += step[a];
@@ -282,6 +308,7 @@ class Tally {
     }
   }
 
+  BrickLayout layout_;
   const Setup& s_;
   ThreadSums& sums_;
   double scale_;
@@ -409,7 +436,7 @@ int threads_for(const Setup& s) {
 
 uint64_t memory_bytes(const Setup& s, int threads) {
   const uint64_t gates = static_cast<uint64_t>(s.time.bins);
-  uint64_t volume = s.fluence ? s.fluence_grid.cells() * gates : 0;
+  uint64_t volume = s.fluence ? BrickLayout(s.fluence_grid.n).slots * gates : 0;
   uint64_t faces = 0;
   if (s.faces)
     for (int a = 0; a < 3; ++a)
@@ -436,7 +463,8 @@ Result simulate(const Setup& s) {
   const int bits = fixed_point_bits(s);
   const double scale = std::ldexp(1.0, bits);
 
-  const size_t volume_size = s.fluence ? s.fluence_grid.cells() * static_cast<size_t>(gates) : 0;
+  const BrickLayout layout(s.fluence_grid.n);
+  const size_t volume_size = s.fluence ? layout.slots * static_cast<size_t>(gates) : 0;
   std::array<size_t, 6> face_size{};
   Result r;
   for (int f = 0; f < 6; ++f) {
@@ -555,24 +583,27 @@ Result simulate(const Setup& s) {
   if (s.fluence) {
     const Vec3 h = s.fluence_grid.spacing();
     const double unit = 1.0 / (scale * N * h.x * h.y * h.z);  // weighted mm -> 1/mm^2 per photon
-    // Sums are gate-major (gate * cells + cell); results are (X,Y,Z,T): cell * gates + gate.
-    const size_t cells = s.fluence_grid.cells(), G = static_cast<size_t>(gates);
-    r.fluence.resize(volume_size);
-    for (size_t g = 0; g < G; ++g)
-      for (size_t c = 0; c < cells; ++c)
-        r.fluence[c * G + g] =
-            static_cast<float>(static_cast<double>(total.fluence[g * cells + c]) * unit);
-    if (s.fluence_stderr) {
-      r.fluence_err.resize(volume_size);
-      const double B = batches, to_fluence = 1.0 / (scale * h.x * h.y * h.z);
-      for (size_t g = 0; g < G; ++g)
-        for (size_t c = 0; c < cells; ++c) {
-          const size_t i = g * cells + c;
-          const double mean = static_cast<double>(total.fluence[i]) / N;  // per photon, fixed units
-          const double var = B > 1 ? std::max(0.0, (sum2[i] - B * mean * mean) / (B - 1)) : 0.0;
-          r.fluence_err[c * G + g] = static_cast<float>(std::sqrt(var / B) * to_fluence);
+    // Sums are gate-major over bricks (gate * slots + brick slot); results are (X,Y,Z,T):
+    // cell * gates + gate with cell = (i ny + j) nz + k.
+    const FluenceGrid& fg = s.fluence_grid;
+    const size_t slots = layout.slots, G = static_cast<size_t>(gates);
+    r.fluence.resize(fg.cells() * G);
+    if (s.fluence_stderr) r.fluence_err.resize(fg.cells() * G);
+    const double B = batches, to_fluence = 1.0 / (scale * h.x * h.y * h.z);
+    size_t c = 0;
+    for (int i = 0; i < fg.n[0]; ++i)
+      for (int j = 0; j < fg.n[1]; ++j)
+        for (int k = 0; k < fg.n[2]; ++k, ++c) {
+          const size_t slot = layout.index(i, j, k);
+          for (size_t g = 0; g < G; ++g) {
+            const size_t q = g * slots + slot;
+            r.fluence[c * G + g] = static_cast<float>(static_cast<double>(total.fluence[q]) * unit);
+            if (!s.fluence_stderr) continue;
+            const double mean = static_cast<double>(total.fluence[q]) / N;  // per photon, fixed units
+            const double var = B > 1 ? std::max(0.0, (sum2[q] - B * mean * mean) / (B - 1)) : 0.0;
+            r.fluence_err[c * G + g] = static_cast<float>(std::sqrt(var / B) * to_fluence);
+          }
         }
-    }
   }
   const double area_pix = s.volume.voxel * s.volume.voxel;
   for (size_t f = 0; f < 6; ++f) {

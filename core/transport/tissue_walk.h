@@ -5,6 +5,7 @@
 // space looks like is a template parameter (an unbounded homogeneous medium, or a labelled voxel
 // grid with Fresnel interfaces), so the hot loop has no virtual calls.
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <vector>
 
@@ -110,21 +111,45 @@ class LabelSpace {
   /// piece (the last voxel before that face, or the voxel at s_stop). Faces between voxels of
   /// the same label are crossed here, without a step of the walk.
   double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3]) const {
-    VoxelDda dda(p.x, p.d, p.cell, vol_.origin, Vec3(vol_.voxel));
+    const VoxelDda dda(p.x, p.d, p.cell, vol_.origin, Vec3(vol_.voxel));
+    // Scalars rather than arrays indexed by the moving axis keep the march in registers; the
+    // voxel's index into the labels moves by a fixed stride per axis.
+    int cx = dda.cell[0], cy = dda.cell[1], cz = dda.cell[2];
+    double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
+    const ptrdiff_t sx = dda.step[0] * static_cast<ptrdiff_t>(vol_.n[1]) * vol_.n[2];
+    const ptrdiff_t sy = dda.step[1] * static_cast<ptrdiff_t>(vol_.n[2]), sz = dda.step[2];
+    const uint16_t* labels = vol_.labels.data();
+    ptrdiff_t i = static_cast<ptrdiff_t>(vol_.index(cx, cy, cz));  // a tissue voxel: in the grid
+    const int label = p.label;
     double s = std::numeric_limits<double>::infinity();
     while (true) {
-      const int a = dda.axis();
-      const double t = dda.t_max[a];
-      if (t >= s_stop) break;
-      int next[3] = {dda.cell[0], dda.cell[1], dda.cell[2]};
-      next[a] += dda.step[a];
-      if (vol_.label_at(next[0], next[1], next[2]) != p.label) {
-        s = t, axis = a;
-        break;
+      if (tx < ty && tx < tz) {  // the same choice as VoxelDda::axis()
+        if (tx >= s_stop) break;
+        const int c = cx + dda.step[0];
+        if (c < 0 || c >= vol_.n[0] || labels[i + sx] != label) {
+          s = tx, axis = 0;
+          break;
+        }
+        cx = c, i += sx, tx += dda.t_delta[0];
+      } else if (!(tx < ty) && ty < tz) {
+        if (ty >= s_stop) break;
+        const int c = cy + dda.step[1];
+        if (c < 0 || c >= vol_.n[1] || labels[i + sy] != label) {
+          s = ty, axis = 1;
+          break;
+        }
+        cy = c, i += sy, ty += dda.t_delta[1];
+      } else {
+        if (tz >= s_stop) break;
+        const int c = cz + dda.step[2];
+        if (c < 0 || c >= vol_.n[2] || labels[i + sz] != label) {
+          s = tz, axis = 2;
+          break;
+        }
+        cz = c, i += sz, tz += dda.t_delta[2];
       }
-      dda.advance(a);
     }
-    end_cell[0] = dda.cell[0], end_cell[1] = dda.cell[1], end_cell[2] = dda.cell[2];
+    end_cell[0] = cx, end_cell[1] = cy, end_cell[2] = cz;
     return s;
   }
 
