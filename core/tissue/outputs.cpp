@@ -72,7 +72,7 @@ nlohmann::json summary_json(const Setup& s, const Result& r) {
            {"detectors", dets},
            {"detected_photons_recorded", r.detected.size()},
            {"detected_photons_dropped", r.detected.dropped},
-           {"counters", {{"scattering_events", r.scatterings}, {"segments", r.segments}}},
+           {"counters", {{"scattering_events", r.scatterings}, {"walk_steps", r.segments}}},
            {"timing",
             {{"seconds", r.seconds},
              {"threads", r.threads},

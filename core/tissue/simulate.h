@@ -39,7 +39,7 @@ struct DetectedPhotons {
 
 struct Result {
   int gates = 0, labels = 0;  ///< labels: size of the optics table (label 0 included)
-  uint64_t photons = 0, scatterings = 0, segments = 0;
+  uint64_t photons = 0, scatterings = 0, segments = 0;  ///< segments: walk steps (one per straight piece within a label)
   int threads = 0, batches = 0;
   double seconds = 0;              ///< the whole run
   double trace_seconds = 0;        ///< tracing photons only (no allocation, reductions, results)
