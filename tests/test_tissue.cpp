@@ -554,3 +554,35 @@ TEST_CASE("detector numerical aperture selects the exit cone", "[tissue]") {
   CHECK(r.detected_weight[0] + r.detected_weight[1] ==
         Approx(r.balance.escaped_faces[4]).epsilon(1e-12));
 }
+
+// Catches a spot source that does not follow the camera scenes' spot light: without falloff
+// (falloff_start = cone_angle) every photon has weight 1 and directions are uniform in the cone,
+// so an NA of sin 15 deg on the far face of a clear slab accepts (1 - cos 15) / (1 - cos 30) of
+// them; with a falloff the launch weights average 1 (a mis-normalised weight is off by the
+// cone's solid angle), within 4 standard errors bounded by the largest weight.
+TEST_CASE("a spot source emits in its cone with unit mean weight", "[tissue]") {
+  Setup s = tissue_box(40, 40, 1, 1.0, TissueOptics{0, 0, 0, 1.0});
+  s.source = Source{};
+  s.source.type = Source::Type::Spot;
+  s.source.position = {20, 20, 0};
+  s.source.direction = {0, 0, 1};
+  s.source.cone_angle_deg = 30;
+  s.source.falloff_start_deg = 30;
+  s.time = TimeAxis{0, 1000, 1};
+  s.fluence = false;
+  s.detectors = {{{20, 20, 1}, 30.0, std::sin(kPi / 12)}};
+  s.photons = 40000;
+  const Result r = simulate(s);
+  const double N = static_cast<double>(s.photons);
+  CHECK(r.balance.launched == Approx(N).epsilon(1e-12));
+  const double p = (1 - std::cos(kPi / 12)) / (1 - std::cos(kPi / 6));
+  INFO("accepted " << r.detected_weight[0] / N << " expected " << p);
+  CHECK(std::abs(r.detected_weight[0] / N - p) <= 4 * std::sqrt(p * (1 - p) / N));
+  s.source.falloff_start_deg = 10;
+  const Result f = simulate(s);
+  const double w_max =
+      (1 - std::cos(kPi / 6)) / (1 - std::cos(kPi / 18));  // falloff >= the inner cone
+  INFO("mean launch weight " << f.balance.launched / N);
+  CHECK(std::abs(f.balance.launched / N - 1) <= 4 * std::sqrt(w_max / N));
+  CHECK(std::abs(f.balance.residual()) <= 1e-12 * f.balance.launched);
+}

@@ -252,13 +252,16 @@ void read_labels(const Reader& rd, const Json& j, const std::string& P, double o
 }
 
 void read_source(const Reader& rd, const Json& j, const std::string& P, Source& src) {
-  rd.object(j, P, {"type", "position", "direction", "waist", "radius", "pulse", "specular"});
+  rd.object(j, P,
+            {"type", "position", "direction", "waist", "radius", "cone_angle", "falloff_start",
+             "pulse", "specular"});
   if (!j.contains("type")) rd.fail(P + "/type", "required");
   const std::string type =
-      rd.string(j["type"], P + "/type", {"pencil", "gaussian", "disk", "isotropic"});
+      rd.string(j["type"], P + "/type", {"pencil", "gaussian", "disk", "isotropic", "spot"});
   src.type = type == "pencil"     ? Source::Type::Pencil
              : type == "gaussian" ? Source::Type::Gaussian
              : type == "disk"     ? Source::Type::Disk
+             : type == "spot"     ? Source::Type::Spot
                                   : Source::Type::Isotropic;
   if (!j.contains("position")) rd.fail(P + "/position", "required");
   src.position = rd.vec3(j["position"], P + "/position");
@@ -280,6 +283,18 @@ void read_source(const Reader& rd, const Json& j, const std::string& P, Source& 
     src.radius = rd.number(j["radius"], P + "/radius", 0, 1e6, true);
   } else if (j.contains("radius")) {
     rd.fail(P + "/radius", "applies to disk sources only");
+  }
+  if (src.type == Source::Type::Spot) {  // the keys and defaults of the camera scenes' spot light
+    if (!j.contains("cone_angle"))
+      rd.fail(P + "/cone_angle", "required for a spot source (degrees)");
+    src.cone_angle_deg = rd.number(j["cone_angle"], P + "/cone_angle", 0, 90, true);
+    src.falloff_start_deg = 0.8 * src.cone_angle_deg;
+    if (j.contains("falloff_start"))
+      src.falloff_start_deg =
+          rd.number(j["falloff_start"], P + "/falloff_start", 0, src.cone_angle_deg);
+  } else {
+    for (const char* k : {"cone_angle", "falloff_start"})
+      if (j.contains(k)) rd.fail(P + "/" + k, "applies to spot sources only");
   }
   if (j.contains("pulse")) {
     const Json& pl = rd.object(j["pulse"], P + "/pulse", {"fwhm", "offset"});

@@ -13,17 +13,20 @@ namespace femto::tissue {
 
 /// A pulsed source. Beams (pencil, gaussian, disk) travel along `direction` from positions in the
 /// plane through `position` perpendicular to it; photons starting outside the tissue fly straight
-/// (in the outside index) to the first tissue voxel.
+/// (in the outside index) to the first tissue voxel. Spot: the camera scenes' spot light (emitted
+/// through core/lights.h), directions uniform in its cone weighted by its smooth falloff.
 struct Source {
-  enum class Type { Pencil, Gaussian, Disk, Isotropic };
+  enum class Type { Pencil, Gaussian, Disk, Isotropic, Spot };
   Type type = Type::Pencil;
   Vec3 position{0, 0, 0};
-  Vec3 direction{0, 0, 1};  ///< unit; unused by isotropic
-  double waist = 0;         ///< gaussian: 1/e^2 intensity radius, mm
-  double radius = 0;        ///< disk: radius, mm
-  double fwhm_ps = 0;       ///< Gaussian pulse FWHM; 0 = delta pulse
-  double offset_ps = 0;     ///< emission time of the pulse centre
-  bool specular = false;    ///< remove the Fresnel reflection at the entry surface from the weight
+  Vec3 direction{0, 0, 1};        ///< unit; unused by isotropic
+  double waist = 0;               ///< gaussian: 1/e^2 intensity radius, mm
+  double radius = 0;              ///< disk: radius, mm
+  double cone_angle_deg = 30;     ///< spot: half-angle of the cone
+  double falloff_start_deg = 24;  ///< spot: half-angle where the smooth falloff starts
+  double fwhm_ps = 0;             ///< Gaussian pulse FWHM; 0 = delta pulse
+  double offset_ps = 0;           ///< emission time of the pulse centre
+  bool specular = false;  ///< remove the Fresnel reflection at the entry surface from the weight
   double sigma_ps() const { return fwhm_ps / 2.3548200450309493; }
 };
 

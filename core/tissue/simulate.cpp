@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
+#include "core/lights.h"
 #include "core/progress.h"
 #include "core/sampling.h"
 #include "media/grid_medium.h"
@@ -143,7 +145,9 @@ class Tally {
 
   // Through int64 (values stay below 2^63 by the choice of scale): one instruction, where a
   // direct double -> uint64 conversion needs a branch for the upper half.
-  uint64_t fixed(double x) const { return static_cast<uint64_t>(static_cast<int64_t>(x * scale_ + 0.5)); }
+  uint64_t fixed(double x) const {
+    return static_cast<uint64_t>(static_cast<int64_t>(x * scale_ + 0.5));
+  }
 
   // Consecutive deposits into the same entry (scatterings inside one voxel) are summed first:
   // fewer memory round trips and fewer roundings.
@@ -324,14 +328,50 @@ class Tally {
   ChunkSums* out_ = nullptr;
 };
 
+// Sources emitted by the camera scenes' light code (spot): the light and the normalisation that
+// makes the mean launch weight 1.
+struct Emitter {
+  SceneDesc scene;
+  std::unique_ptr<LightSet> lights;
+  double inv_mean_beta = 1;
+  explicit Emitter(const Source& src) {
+    if (src.type != Source::Type::Spot) return;
+    LightDesc d;
+    d.type = LightDesc::Type::Spot;
+    d.position = src.position;
+    d.direction = src.direction;
+    d.intensity = RGB(1.0);
+    d.cone_angle_deg = src.cone_angle_deg;
+    d.falloff_deg = src.falloff_start_deg;
+    scene.lights = {d};
+    lights = std::make_unique<LightSet>(scene);
+    // E[beta] over u1 (the cone's cosine is linear in u1, the falloff smooth): midpoint rule,
+    // relative error ~1e-10.
+    const int m = 200000;
+    double sum = 0, carry = 0;  // compensated: a constant weight comes out 1 to rounding
+    for (int i = 0; i < m; ++i) {
+      LightEmission e;
+      if (!lights->sample_emission(0, (i + 0.5) / m, 0.25, 0.5, 0.5, e)) continue;
+      const double y = e.beta.r - carry, t = sum + y;
+      carry = (t - sum) - y;
+      sum = t;
+    }
+    inv_mean_beta = sum > 0 ? m / sum : 0.0;
+  }
+};
+
+bool launch(const Setup& s, const LabelSpace& space, const Emitter& emitter, Rng& rng, Photon& p,
+            double& specular);
+
 template <class Tally>
-void trace_photon(const Setup& s, const LabelSpace& space, const WalkSettings& ws, Rng rng,
-                  Tally& tally, ChunkSums& out) {
+void trace_photon(const Setup& s, const LabelSpace& space, const Emitter& emitter,
+                  const WalkSettings& ws, Rng rng, Tally& tally, ChunkSums& out) {
   Photon p;
   double specular = 0;
-  out.balance.launched += 1.0;
-  if (!launch(s, space, rng, p, specular)) {
-    out.balance.missed += 1.0;
+  const bool entered = launch(s, space, emitter, rng, p, specular);
+  out.balance.launched += p.w + specular;  // 1, or a spot light's falloff weight (mean 1)
+  if (!entered) {
+    out.balance.missed += p.w;
     return;
   }
   out.balance.specular += specular;
@@ -355,7 +395,12 @@ void trace_photon(const Setup& s, const LabelSpace& space, const WalkSettings& w
 }
 }  // namespace
 
-bool launch(const Setup& s, const LabelSpace& space, Rng& rng, Photon& p, double& specular) {
+namespace {
+// Launches photon p from the source (position, direction, time, weight) and moves it to the first
+// tissue voxel; false when it never reaches tissue. `specular` receives the weight reflected at
+// the entry surface (source.specular), already removed from p.w.
+bool launch(const Setup& s, const LabelSpace& space, const Emitter& emitter, Rng& rng, Photon& p,
+            double& specular) {
   const Source& src = s.source;
   const LabelVolume& vol = space.volume();
   specular = 0;
@@ -373,6 +418,15 @@ bool launch(const Setup& s, const LabelSpace& space, Rng& rng, Photon& p, double
   } else if (src.type == Source::Type::Isotropic) {
     const double u1 = rng.uniform(), u2 = rng.uniform();
     p.d = sample_uniform_sphere(u1, u2);
+  } else if (src.type == Source::Type::Spot) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    LightEmission e;
+    if (!emitter.lights->sample_emission(0, u1, u2, 0.5, 0.5, e)) {
+      p.w = 0;  // outside the falloff: no energy (never for u1 < 1)
+      return false;
+    }
+    p.d = e.ray.d;
+    p.w = e.beta.r * emitter.inv_mean_beta;
   }
   // Into the grid's box (slab test); `axis` is the face it enters through, -1 if inside.
   double s_in = 0, s_out = std::numeric_limits<double>::infinity();
@@ -416,8 +470,8 @@ bool launch(const Setup& s, const LabelSpace& space, Rng& rng, Photon& p, double
   if (axis >= 0 && s.fresnel && n1 != n2) {
     const Fresnel fr = fresnel_dielectric(std::abs(p.d[axis]), n2 / n1);
     if (src.specular) {
-      specular = fr.R;
-      p.w = 1.0 - fr.R;
+      specular = p.w * fr.R;
+      p.w -= specular;
     }
     if (fr.R < 1.0) {  // Snell at the entry surface
       const double sign = p.d[axis] > 0 ? 1.0 : -1.0;
@@ -428,6 +482,7 @@ bool launch(const Setup& s, const LabelSpace& space, Rng& rng, Photon& p, double
   }
   return true;
 }
+}  // namespace
 
 int threads_for(const Setup& s) {
   const int hardware = tbb::info::default_concurrency();
@@ -454,6 +509,7 @@ uint64_t memory_bytes(const Setup& s, int threads) {
 Result simulate(const Setup& s) {
   const auto start = std::chrono::steady_clock::now();
   const LabelSpace space(s.volume, s.fresnel);
+  const Emitter emitter(s.source);
   const WalkSettings ws{s.absorption, s.time.t_end_ps()};
   const int threads = threads_for(s);
   const int gates = s.time.bins;
@@ -506,7 +562,7 @@ Result simulate(const Setup& s) {
         Tally tally(s, ts, scale);
         const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
         for (uint64_t i = q0; i < q1; ++i)
-          trace_photon(s, space, ws, Rng::for_sample(s.seed, i, 0), tally, out);
+          trace_photon(s, space, emitter, ws, Rng::for_sample(s.seed, i, 0), tally, out);
         progress.add(q1 - q0);
       });
     });
@@ -599,7 +655,8 @@ Result simulate(const Setup& s) {
             const size_t q = g * slots + slot;
             r.fluence[c * G + g] = static_cast<float>(static_cast<double>(total.fluence[q]) * unit);
             if (!s.fluence_stderr) continue;
-            const double mean = static_cast<double>(total.fluence[q]) / N;  // per photon, fixed units
+            const double mean =
+                static_cast<double>(total.fluence[q]) / N;  // per photon, fixed units
             const double var = B > 1 ? std::max(0.0, (sum2[q] - B * mean * mean) / (B - 1)) : 0.0;
             r.fluence_err[c * G + g] = static_cast<float>(std::sqrt(var / B) * to_fluence);
           }

@@ -67,9 +67,5 @@ int threads_for(const Setup& setup);
 
 Result simulate(const Setup& setup);
 
-/// Launches photon `p` from the source (position, direction, time) and moves it to the first
-/// tissue voxel. Returns false when it never reaches tissue. `specular` receives the weight
-/// reflected at the entry surface (source.specular), already removed from p.w.
-bool launch(const Setup& setup, const LabelSpace& space, Rng& rng, Photon& p, double& specular);
 
 }  // namespace femto::tissue
