@@ -96,8 +96,7 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
   const uint64_t max_memory =
       opt.max_memory ? opt.max_memory : cli::physical_memory_bytes() / 4 * 3;
   const uint64_t need = tissue::memory_bytes(s, threads);
-  const uint64_t volume_bytes =
-      s.fluence ? s.fluence_grid.cells() * static_cast<uint64_t>(s.time.bins) : 0;
+  const uint64_t fluence_bytes = tissue::fluence_bytes_per_thread(s);
   if (need > max_memory)
     throw InputError(
         path + ": the run needs " + cli::format_bytes(need) + " (fluence volume " +
@@ -128,7 +127,7 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
         path.c_str(), s.volume.n[0], s.volume.n[1], s.volume.n[2], s.volume.voxel,
         s.volume.optics.size() - 1, s.fresnel ? "Fresnel" : "index-matched",
         static_cast<unsigned long long>(s.photons), s.time.bins, s.time.bin_width_ps,
-        cli::format_bytes(volume_bytes * 8).c_str(), threads,
+        cli::format_bytes(fluence_bytes).c_str(), threads,
         cli::format_bytes(s.volume.memory_bytes()).c_str(), cli::format_bytes(need).c_str());
   OutputFolder folder(opt.out, false);
   const tissue::Result r = tissue::simulate(s);

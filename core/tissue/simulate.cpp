@@ -489,6 +489,11 @@ int threads_for(const Setup& s) {
   return s.threads > 0 ? std::min(s.threads, hardware) : hardware;
 }
 
+uint64_t fluence_bytes_per_thread(const Setup& s) {
+  return s.fluence ? BrickLayout(s.fluence_grid.n).slots * static_cast<uint64_t>(s.time.bins) * 8
+                   : 0;
+}
+
 uint64_t memory_bytes(const Setup& s, int threads) {
   const uint64_t gates = static_cast<uint64_t>(s.time.bins);
   uint64_t volume = s.fluence ? BrickLayout(s.fluence_grid.n).slots * gates : 0;

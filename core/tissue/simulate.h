@@ -39,7 +39,8 @@ struct DetectedPhotons {
 
 struct Result {
   int gates = 0, labels = 0;  ///< labels: size of the optics table (label 0 included)
-  uint64_t photons = 0, scatterings = 0, segments = 0;  ///< segments: walk steps (one per straight piece within a label)
+  uint64_t photons = 0, scatterings = 0,
+           segments = 0;  ///< segments: walk steps (one per straight piece within a label)
   int threads = 0, batches = 0;
   double seconds = 0;              ///< the whole run
   double trace_seconds = 0;        ///< tracing photons only (no allocation, reductions, results)
@@ -62,10 +63,11 @@ struct Result {
 
 /// Memory the run allocates (tallies per thread, sums, results), bytes.
 uint64_t memory_bytes(const Setup& setup, int threads);
+/// Of which the fluence sums of one thread (cells padded to whole 4^3 bricks x gates x 8 bytes).
+uint64_t fluence_bytes_per_thread(const Setup& setup);
 /// Threads the run will use for setup.threads.
 int threads_for(const Setup& setup);
 
 Result simulate(const Setup& setup);
-
 
 }  // namespace femto::tissue
