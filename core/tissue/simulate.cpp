@@ -75,13 +75,13 @@ struct ThreadSums {
 };
 
 // The fixed-point scale 2^k: no cell of any sum can overflow 2^63 (a photon's track length is at
-// most c times the window; every launched photon has weight <= 1).
-int fixed_point_bits(const Setup& s) {
+// most c times the window; a launched photon's weight is at most max_weight).
+int fixed_point_bits(const Setup& s, double max_weight) {
   const double t_span =
       s.time.t_end_ps() - std::min(s.time.t_start_ps, s.source.offset_ps - 8 * s.source.sigma_ps());
   const double max_track = kSpeedOfLight * std::max(t_span, s.time.bin_width_ps) + 1.0;
   const double headroom =
-      9.2e18 / (static_cast<double>(std::max<uint64_t>(s.photons, 1)) * max_track);
+      9.2e18 / (static_cast<double>(std::max<uint64_t>(s.photons, 1)) * max_track * max_weight);
   return std::clamp(static_cast<int>(std::floor(std::log2(headroom))), 0, 40);
 }
 
@@ -334,6 +334,7 @@ struct Emitter {
   SceneDesc scene;
   std::unique_ptr<LightSet> lights;
   double inv_mean_beta = 1;
+  double max_weight = 1;  ///< the largest launch weight
   explicit Emitter(const Source& src) {
     if (src.type != Source::Type::Spot) return;
     LightDesc d;
@@ -357,6 +358,8 @@ struct Emitter {
       sum = t;
     }
     inv_mean_beta = sum > 0 ? m / sum : 0.0;
+    // The largest beta: falloff 1 over the cone's solid angle (unit intensity).
+    max_weight = inv_mean_beta * 2 * kPi * (1 - std::cos(src.cone_angle_deg * kPi / 180));
   }
 };
 
@@ -521,7 +524,7 @@ Result simulate(const Setup& s) {
   const int labels = static_cast<int>(s.volume.optics.size());
   const size_t ndet = s.detectors.size();
   const size_t tpsf_size = ndet * static_cast<size_t>(gates);
-  const int bits = fixed_point_bits(s);
+  const int bits = fixed_point_bits(s, std::max(1.0, emitter.max_weight));
   const double scale = std::ldexp(1.0, bits);
 
   const BrickLayout layout(s.fluence_grid.n);
