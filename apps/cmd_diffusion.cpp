@@ -67,6 +67,8 @@ const char* kDiffusionHelp =
     "                     signal aborts\n"
     "  --seed S           random seed, integer >= 0; the same seed gives bit-identical output for\n"
     "                     any thread count (default 1)\n"
+    "  --batches N        independent batches for the jackknife interval of t*, 2..1000\n"
+    "                     (default 10)\n"
     "  --threads N        worker threads, 0 = all cores (default 0)\n"
     "  --out DIR          output folder, created if missing (default ./femto-diffusion)\n"
     "  --quiet            no progress or summary on stderr\n"
@@ -167,6 +169,8 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
       setup.max_seconds = args.number_in(0, 1e9, true, false, "in (0, 1e9] s");
     } else if (a == "--seed") {
       setup.seed = args.uint_value();
+    } else if (a == "--batches") {
+      setup.batches = static_cast<int>(args.int_value(2, 1000));
     } else if (a == "--threads") {
       setup.threads = static_cast<int>(args.int_value(0, 4096));
     } else if (a == "--out") {
@@ -301,13 +305,24 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
                  static_cast<unsigned long long>(result.segments),
                  format_duration(result.seconds).c_str(), result.threads);
     const diffusion::Transition& t = analysis.gaussian;
-    if (t.reached)
+    const diffusion::TransitionConfidence c = diffusion::transition_confidence(setup, result, analysis);
+    if (t.reached) {
       std::fprintf(
           stderr,
           "femto diffusion: t* = %.4g ps = %.3g mean free times = %.3g transport mean free paths "
           "(distance to the Gaussian of the same <r^2> stays below %g%%)%s\n",
           t.t_ps, t.t_ps / sc.mean_free_time, t.t_ps * sc.v * sc.sigma_tr, 100 * threshold,
           t.from_start ? " from the window start" : "");
+      if (std::isfinite(c.se_ps))
+        std::fprintf(stderr, "femto diffusion: t* 95%% interval [%.4g, %.4g] ps = [%.3g, %.3g] mean free times (jackknife over %d batches)\n",
+                     c.ci_lo_ps, c.ci_hi_ps, c.ci_lo_ps / sc.mean_free_time, c.ci_hi_ps / sc.mean_free_time, c.batches);
+      if (c.noise_limited)
+        std::fprintf(stderr,
+                     "femto diffusion: warning: t* is decided by Monte Carlo noise (noise floor %.3g%% at t*, "
+                     "t* with the floor subtracted %.4g ps): not a property of the medium; use more photons or a "
+                     "larger --threshold\n",
+                     100 * c.noise_at_t_star, c.floor_subtracted.t_ps);
+    }
     else
       std::fprintf(stderr,
                    "femto diffusion: the profile does not stay within %g%% of a Gaussian inside "

@@ -20,6 +20,8 @@
 #include "core/memory_usage.h"
 #include "core/output_folder.h"
 #include "apps/render_record.h"
+#include "apps/tissue_run.h"
+#include "core/tissue/scene.h"
 #include "core/default_scene.h"
 #include "core/error.h"
 #include "core/outputs.h"
@@ -259,6 +261,27 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     desc = load_scene_string(scene_text, "<default scene>", ".");
   } else {
     scene_text = read_scene_text(scene_path);  // read once, size-limited
+    if (tissue::is_tissue_scene(scene_text)) {  // tissue optics (docs/tissue.md)
+      const char* camera_only = spp ? "--spp" : max_depth ? "--max-depth" : sampling ? "--distance-sampling"
+                              : connection ? "--connection-sampling" : direction ? "--direction-sampling"
+                              : reconstruction ? "--reconstruction" : !kernel_flag.empty() ? "--kernel"
+                              : integrator ? "--integrator" : light_paths ? "--light-paths"
+                              : photon_radius ? "--photon-radius" : photon_bandwidth ? "--photon-bandwidth"
+                              : checkpoint ? "--checkpoint" : !resume_dir.empty() ? "--resume"
+                              : !out.previews ? "--no-previews" : nullptr;
+      if (camera_only)
+        throw InputError(std::string("femto render: ") + camera_only + ": does not apply to the tissue scene " +
+                         clip(scene_path, 200) + " (its options: --photons, --seed, --threads, --out, "
+                         "--max-memory, --quiet)");
+      TissueRunOptions t;
+      if (photons_per_pass) t.photons = static_cast<uint64_t>(*photons_per_pass);
+      t.seed = seed;
+      t.threads = threads;
+      if (out_given) t.out = out.dir;
+      t.quiet = quiet;
+      t.max_memory = max_memory;
+      return run_tissue_scene(scene_text, scene_path, t, command_line);
+    }
     desc = load_scene_string(scene_text, scene_path,
                              std::filesystem::path(scene_path).parent_path().string());
   }

@@ -256,6 +256,9 @@ class Loader {
     SceneDesc scene;
     scene.source = source_;
     if (!root.is_object()) fail("/", "the scene must be a JSON object", root);
+    if (root.contains("tissue"))  // a tissue-optics run, not a camera scene
+      fail("/tissue", "a tissue-optics scene (docs/tissue.md): run it with femto render or femto tissue; "
+                      "it cannot be used as a camera scene here");
     check_keys(root, "", {"camera", "time", "media", "medium", "shapes", "lights", "render"});
     camera(require(root, "", "camera"), scene.camera);
     time(require(root, "", "time"), scene);

@@ -1,4 +1,5 @@
-// libFuzzer target: the scene loader (load_scene_string) on arbitrary text.
+// libFuzzer target: the scene loaders (load_scene_string, and load_tissue_scene for text with a
+// top-level "tissue") on arbitrary text.
 // Bad input must be an InputError; any other exception, a crash, a hang or a sanitizer report is
 // a finding. Mesh and volume paths resolve against data/scenes, so the seeds' "../meshes/..."
 // and "../volumes/..." references exist (volumes are only checked for existence here).
@@ -11,13 +12,20 @@
 
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "core/tissue/scene.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    const femto::SceneDesc scene =
-        femto::load_scene_string(text, "fuzz.json", FEMTO_SOURCE_DIR "/data/scenes");
-    (void)scene;
+    if (femto::tissue::is_tissue_scene(text)) {  // what femto render does with a tissue scene
+      const femto::tissue::Setup setup =
+          femto::tissue::load_tissue_scene(text, "fuzz.json", FEMTO_SOURCE_DIR "/data/scenes");
+      (void)setup;
+    } else {
+      const femto::SceneDesc scene =
+          femto::load_scene_string(text, "fuzz.json", FEMTO_SOURCE_DIR "/data/scenes");
+      (void)scene;
+    }
   } catch (const femto::InputError&) {
     // expected for bad input
   } catch (const std::exception& e) {

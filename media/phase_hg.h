@@ -21,7 +21,7 @@ inline double hg_sample_cos(double u, double g) {
   if (std::abs(g) < 1e-3) return 1.0 - 2.0 * u;
   const double sq = (1.0 - g * g) / (1.0 - g + 2.0 * g * u);
   const double c = (1.0 + g * g - sq * sq) / (2.0 * g);
-  return std::fmax(-1.0, std::fmin(1.0, c));
+  return c < -1.0 ? -1.0 : (c > 1.0 ? 1.0 : c);  // comparisons inline; std::fmin/fmax are calls
 }
 
 struct PhaseSample {
@@ -32,7 +32,8 @@ struct PhaseSample {
 /// Samples a new propagation direction around the current propagation direction `d`.
 inline PhaseSample hg_sample(const Vec3& d, double g, double u1, double u2) {
   const double cos_t = hg_sample_cos(u1, g);
-  const double sin_t = std::sqrt(std::fmax(0.0, 1.0 - cos_t * cos_t));
+  const double sin2_t = 1.0 - cos_t * cos_t;
+  const double sin_t = std::sqrt(sin2_t > 0.0 ? sin2_t : 0.0);
   const double phi = 2.0 * kPi * u2;
   const Frame f(d);
   const Vec3 dir = f.to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t});

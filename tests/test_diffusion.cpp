@@ -465,3 +465,33 @@ TEST_CASE("femto diffusion writes the documented outputs, identical for any thre
   REQUIRE(js["models"].contains("paasschens"));
   REQUIRE(js["at_plot_times"].size() == 3);
 }
+
+// Catches a t* reported without its uncertainty or trusted when noise decides it: at 3e4
+// photons and a 2% threshold the noise floor at t* is about the threshold itself (flagged); at
+// 3e5 photons and 5% it is not, the jackknife interval is finite, and an independent seed's t*
+// lies within the combined intervals (4 combined standard errors).
+TEST_CASE("t* comes with a jackknife interval and a noise-floor flag", "[diffusion][statistical]") {
+  auto run = [](uint64_t photons, uint64_t seed, double threshold) {
+    DiffusionSetup s = make_setup(4.1, 0, 0, 1, Absorption::Weighted, 0, 20 / (4.1 * kSpeedOfLight), 80,
+                                  20 / 4.1, 100, photons);
+    s.seed = seed;
+    const DiffusionResult r = simulate(s);
+    const Analysis a = analyse(s, r, threshold);
+    return std::make_pair(a, transition_confidence(s, r, a));
+  };
+  const auto [a_few, c_few] = run(30000, 7, 0.02);
+  INFO("3e4 photons, 2%: t* " << a_few.gaussian.t_ps << ", floor at t* " << c_few.noise_at_t_star);
+  CHECK(c_few.noise_limited);
+  const auto [a1, c1] = run(300000, 7, 0.05);
+  const auto [a2, c2] = run(300000, 8, 0.05);
+  INFO("3e5 photons, 5%: t* " << a1.gaussian.t_ps << " +- " << c1.se_ps << " and " << a2.gaussian.t_ps << " +- "
+                              << c2.se_ps << "; floor " << c1.noise_at_t_star);
+  REQUIRE(a1.gaussian.reached);
+  CHECK(!c1.noise_limited);
+  CHECK(c1.batches == 10);
+  REQUIRE(std::isfinite(c1.se_ps));
+  CHECK(c1.se_ps > 0);
+  CHECK(c1.ci_lo_ps < a1.gaussian.t_ps);
+  CHECK(c1.ci_hi_ps > a1.gaussian.t_ps);
+  CHECK(std::abs(a1.gaussian.t_ps - a2.gaussian.t_ps) <= 4 * std::hypot(c1.se_ps, c2.se_ps));
+}

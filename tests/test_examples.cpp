@@ -7,16 +7,29 @@
 
 #include "core/render.h"
 #include "core/scene_loader.h"
+#include "core/tissue/scene.h"
+#include "core/tissue/simulate.h"
 
 using namespace femto;
 
-// Catches: example scenes drifting out of sync with the scene format or the tracer.
+// Catches: example scenes drifting out of sync with the scene format or the tracer (tissue
+// scenes: with the tissue loader, a few photons, energy balanced).
 TEST_CASE("example scenes load and render", "[examples]") {
   const std::filesystem::path dir = std::filesystem::path(FEMTO_SOURCE_DIR) / "data" / "scenes";
   int count = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".json") continue;
     INFO(entry.path().string());
+    const std::string text = read_scene_text(entry.path().string());
+    if (tissue::is_tissue_scene(text)) {
+      tissue::Setup t = tissue::load_tissue_scene(text, entry.path().string(), dir.string());
+      t.photons = 500;
+      const tissue::Result r = tissue::simulate(t);
+      CHECK(r.balance.absorbed > 0);
+      CHECK(std::abs(r.balance.residual()) <= 1e-12 * r.balance.launched);
+      ++count;
+      continue;
+    }
     SceneDesc desc = load_scene_file(entry.path().string());
     desc.camera.width = 24;
     desc.camera.height = 18;

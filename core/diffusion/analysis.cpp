@@ -115,3 +115,86 @@ Analysis analyse(const DiffusionSetup& setup, const DiffusionResult& r, double t
 }
 
 }  // namespace femto::diffusion
+
+namespace femto::diffusion {
+
+std::vector<double> gaussian_distances(const DiffusionSetup& setup, const DiffusionResult& r) {
+  const Grid& g = r.grid;
+  std::vector<double> d(static_cast<size_t>(g.time.bins), NAN);
+  for (int j = 0; j < g.time.bins; ++j) {
+    const size_t J = static_cast<size_t>(j);
+    const double t0 = g.time.bin_start_ps(j), dt = g.time.bin_width_ps;
+    const double S = survival_integral(setup.medium, t0, t0 + dt);
+    const double E = r.energy[J], r2_mc = E > 0 ? r.r2[J] * (S / dt) / E : 0.0;
+    if (r2_mc >= kMinShellsPerRms * kMinShellsPerRms * g.dr * g.dr)
+      d[J] = tv_distance(mc_shell_masses(r, j), gaussian_shell_masses(g, r2_mc / 3));
+  }
+  return d;
+}
+
+double student_t95(int dof) {
+  static const double kTable[30] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306,
+                                    2.262,  2.228, 2.201, 2.179, 2.160, 2.145, 2.131, 2.120,
+                                    2.110,  2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064,
+                                    2.060,  2.056, 2.052, 2.048, 2.045, 2.042};
+  if (dof < 1) return NAN;
+  return dof <= 30 ? kTable[dof - 1] : 1.96 + 2.4 / dof;  // within 0.3% above 30
+}
+
+TransitionConfidence transition_confidence(const DiffusionSetup& setup, const DiffusionResult& r,
+                                           const Analysis& a) {
+  TransitionConfidence c;
+  const TimeAxis& axis = r.grid.time;
+  // Noise-floor diagnostics.
+  std::vector<double> sub(a.gaussian_distance.size(), NAN);
+  for (size_t j = 0; j < sub.size(); ++j)
+    if (std::isfinite(a.gaussian_distance[j]))
+      sub[j] = std::max(0.0, a.gaussian_distance[j] - (std::isfinite(a.gaussian_noise[j]) ? a.gaussian_noise[j] : 0.0));
+  c.floor_subtracted = transition_time(axis, sub, a.threshold);
+  if (a.gaussian.reached) {
+    const double u = (a.gaussian.t_ps - axis.t_start_ps) / axis.bin_width_ps - 0.5;
+    const int j0 = std::clamp(static_cast<int>(std::floor(u)), 0, axis.bins - 1);
+    const int j1 = std::min(j0 + 1, axis.bins - 1);
+    const double f = std::clamp(u - j0, 0.0, 1.0);
+    const double n0 = a.gaussian_noise[static_cast<size_t>(j0)], n1 = a.gaussian_noise[static_cast<size_t>(j1)];
+    c.noise_at_t_star = std::isfinite(n0) && std::isfinite(n1) ? (1 - f) * n0 + f * n1 : NAN;
+    const bool floor_high = std::isfinite(c.noise_at_t_star) && c.noise_at_t_star >= 0.5 * a.threshold;
+    const bool moves = !c.floor_subtracted.reached ||
+                       a.gaussian.t_ps - c.floor_subtracted.t_ps > 0.25 * (a.gaussian.t_ps - axis.t_start_ps);
+    c.noise_limited = floor_high || moves;
+  } else {
+    c.noise_limited = true;  // no t*: nothing to trust
+  }
+  // Jackknife: leave each batch out, recompute the distances and t*.
+  const size_t B = r.batch_sum.size();
+  c.batches = static_cast<int>(B);
+  if (B < 2 || !a.gaussian.reached) return c;
+  const TallyLayout layout{r.grid.shells, r.grid.time.bins};
+  std::vector<double> all(layout.size(), 0.0);
+  for (const auto& bs : r.batch_sum)
+    for (size_t i = 0; i < all.size(); ++i) all[i] += bs[i];
+  std::vector<double> t_rep;
+  for (size_t b = 0; b < B; ++b) {
+    TallySums rest;
+    rest.reset(layout.size());
+    for (size_t i = 0; i < all.size(); ++i) rest.sum[i] = all[i] - r.batch_sum[b][i];
+    rest.photons = r.photons - r.batch_photons[b];
+    const DiffusionResult rb = estimate(setup, rest);
+    const Transition tb = transition_time(axis, gaussian_distances(setup, rb), a.threshold);
+    if (tb.reached) t_rep.push_back(tb.t_ps);
+  }
+  c.replicates_reached = static_cast<int>(t_rep.size());
+  if (t_rep.size() != B) return c;  // some replicate never settles: no interval
+  double mean = 0;
+  for (double t : t_rep) mean += t;
+  mean /= static_cast<double>(B);
+  double ss = 0;
+  for (double t : t_rep) ss += (t - mean) * (t - mean);
+  c.se_ps = std::sqrt((static_cast<double>(B) - 1) / static_cast<double>(B) * ss);
+  const double q = student_t95(static_cast<int>(B) - 1);
+  c.ci_lo_ps = std::max(axis.t_start_ps, a.gaussian.t_ps - q * c.se_ps);  // t* lies in the window
+  c.ci_hi_ps = std::min(axis.t_end_ps(), a.gaussian.t_ps + q * c.se_ps);
+  return c;
+}
+
+}  // namespace femto::diffusion

@@ -49,4 +49,31 @@ struct Analysis {
 
 Analysis analyse(const DiffusionSetup& setup, const DiffusionResult& r, double threshold);
 
+/// Per bin: the distance between the MC radial profile and the Gaussian of the same <r^2>
+/// (NaN where the rms radius spans fewer than kMinShellsPerRms shells).
+std::vector<double> gaussian_distances(const DiffusionSetup& setup, const DiffusionResult& r);
+
+/// t* with its uncertainty and the role of Monte Carlo noise.
+struct TransitionConfidence {
+  int batches = 0;         ///< jackknife replicates (batches of the run); < 2: no interval
+  int replicates_reached = 0;  ///< replicates whose distance settles below the threshold
+  double se_ps = NAN;      ///< jackknife standard error of t*
+  double ci_lo_ps = NAN, ci_hi_ps = NAN;  ///< 95% interval, t* -+ t_{B-1} se (Student), clipped to the window
+  double noise_at_t_star = NAN;  ///< noise floor of the distance at t* (interpolated)
+  /// t* of the distance minus its noise floor (clamped at 0): subtracting the floor
+  /// over-corrects, so this is an early bound and the plain t* a late one.
+  Transition floor_subtracted;
+  /// The noise floor decides t*: at t* it is at least half the threshold, or t* moves by more
+  /// than a quarter of itself between the two bounds. Such a t* is flagged, not trusted.
+  bool noise_limited = false;
+};
+
+/// Jackknife over the run's batches (each replicate leaves one batch out and recomputes t*),
+/// and the noise-floor diagnostics of a.gaussian.
+TransitionConfidence transition_confidence(const DiffusionSetup& setup, const DiffusionResult& r,
+                                           const Analysis& a);
+
+/// Two-sided 95% quantile of Student's t with `dof` degrees of freedom (1.96 for large dof).
+double student_t95(int dof);
+
 }  // namespace femto::diffusion

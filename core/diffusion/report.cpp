@@ -198,6 +198,25 @@ nlohmann::json summary_json(const DiffusionSetup& setup, const DiffusionResult& 
       "between bin centres. Bins whose rms radius spans fewer than 3 shells count as above.";
   j["transition"]["threshold"] = a.threshold;
   j["transition"]["by_threshold"] = table(a.gaussian_distance);
+  {
+    const TransitionConfidence c = transition_confidence(setup, r, a);
+    j["transition"]["confidence"] = {
+        {"batches", c.batches},
+        {"replicates_reached", c.replicates_reached},
+        {"t_star_jackknife_se_ps", num(c.se_ps)},
+        {"t_star_ci95_ps", {num(c.ci_lo_ps), num(c.ci_hi_ps)}},
+        {"t_star_ci95_mean_free_times", {num(c.ci_lo_ps / sc.mean_free_time), num(c.ci_hi_ps / sc.mean_free_time)}},
+        {"noise_floor_at_t_star", num(c.noise_at_t_star)},
+        {"t_star_noise_subtracted_ps", num(c.floor_subtracted.t_ps)},
+        {"noise_limited", c.noise_limited},
+        {"method",
+         "95% interval t* -+ t(B-1) se, se from the jackknife over B batches (each replicate "
+         "leaves one batch out and recomputes t*). The noise floor (the distance MC noise alone "
+         "gives) biases the distance upward, so t* is late; t_star_noise_subtracted_ps uses the "
+         "distance minus the floor (an over-correction, so an early bound). noise_limited: the "
+         "floor is at least half the threshold at t*, or the two differ by more than a quarter of "
+         "t*: then the noise, not the medium, decides t*; run more photons or a larger threshold"}};
+  }
 
   double gmin = NAN, noise_max = 0;
   for (size_t k = 0; k < a.gaussian_distance.size(); ++k) {

@@ -59,6 +59,10 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
 
   TallySums total;
   total.reset(layout.size());
+  // Statistical batches: contiguous ranges of the work units, fixed by the photon count.
+  const uint64_t stat_batches = std::clamp<uint64_t>(static_cast<uint64_t>(std::max(setup.batches, 1)), 1, batches);
+  std::vector<std::vector<double>> batch_sum(stat_batches, std::vector<double>(layout.size(), 0.0));
+  std::vector<uint64_t> batch_photons(stat_batches, 0);
   bool stopped_early = false;
   std::vector<TallySums> partial(slots);
   tbb::enumerable_thread_specific<PhotonTally> tallies([&] { return PhotonTally(grid); });
@@ -79,7 +83,13 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
         progress.add(p1 - p0);
       });
     });
-    for (size_t k = 0; k < count; ++k) total.add(partial[k]);  // batch order: thread-independent
+    for (size_t k = 0; k < count; ++k) {  // batch order: thread-independent
+      total.add(partial[k]);
+      const uint64_t b = (first + k) * stat_batches / batches;
+      std::vector<double>& bs = batch_sum[b];
+      for (size_t i = 0; i < bs.size(); ++i) bs[i] += partial[k].sum[i];
+      batch_photons[b] += partial[k].photons;
+    }
     const double elapsed = seconds_since(start);
     if (first == 0 && !setup.quiet) print_estimate(elapsed, slots * kBatch, N);
     const bool more = first + slots < batches;
@@ -91,12 +101,25 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
   }
   progress.finish();
 
+  DiffusionResult r = estimate(setup, total);
+  r.stopped_early = stopped_early;
+  r.threads = threads;
+  for (size_t b = 0; b < stat_batches; ++b)
+    if (batch_photons[b] > 0) {  // batches not reached when stopped early are left out
+      r.batch_sum.push_back(std::move(batch_sum[b]));
+      r.batch_photons.push_back(batch_photons[b]);
+    }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+DiffusionResult estimate(const DiffusionSetup& setup, const TallySums& total) {
+  const Grid& grid = setup.grid;
+  const TallyLayout layout{grid.shells, grid.time.bins};
   DiffusionResult r;
   r.grid = grid;
   r.photons = total.photons;
-  r.stopped_early = stopped_early;
   r.segments = total.segments;
-  r.threads = threads;
   const double n = static_cast<double>(std::max<uint64_t>(total.photons, 1));
   // Mean and standard error of the per-photon integrals at index i, times scale.
   auto estimate = [&](size_t i, double scale, double& mean, double& err) {
@@ -132,7 +155,6 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
     ratio(Quantity::Unscattered, r.unscattered[j], r.unscattered_err[j]);
     ratio(Quantity::Single, r.single[j], r.single_err[j]);
   }
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
 

@@ -30,6 +30,9 @@ struct DiffusionSetup {
   /// estimate from fewer photons): a flag set from outside (Ctrl-C), and a time budget.
   const std::atomic<bool>* stop = nullptr;
   double max_seconds = 0;  ///< 0: no limit
+  /// Independent batches (contiguous photon ranges) kept apart for confidence intervals of
+  /// derived values such as t* (jackknife); 1: none.
+  int batches = 10;
 };
 
 /// Means and standard errors per unit emitted energy. Per-bin values are averages over the bin.
@@ -46,6 +49,9 @@ struct DiffusionResult {
   /// Fractions of the (exact mean) energy present that are unscattered and singly scattered.
   std::vector<double> unscattered, unscattered_err, single, single_err;
   uint64_t photons = 0, segments = 0;  ///< photons traced (fewer than asked when stopped early)
+  /// Per batch: the sums of the per-photon integrals (TallyLayout order) and the photons traced.
+  std::vector<std::vector<double>> batch_sum;
+  std::vector<uint64_t> batch_photons;
   bool stopped_early = false;
   int threads = 0;
   double seconds = 0;
@@ -58,5 +64,9 @@ struct DiffusionResult {
 DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& transport);
 /// The infinite homogeneous medium setup.medium with setup.absorption.
 DiffusionResult simulate(const DiffusionSetup& setup);
+
+/// Means and standard errors from sums over photons (what simulate returns, without timing
+/// and batches); with the photons of one batch removed, a jackknife replicate.
+DiffusionResult estimate(const DiffusionSetup& setup, const TallySums& sums);
 
 }  // namespace femto::diffusion

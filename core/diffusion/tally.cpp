@@ -53,11 +53,6 @@ void exp_moments(double k, double h, double J[5]) {
   }
 }
 
-double exp_integral(double k, double a, double b) {
-  if (k == 0) return b - a;
-  return std::exp(-k * a) * -std::expm1(-k * (b - a)) / k;
-}
-
 PhotonTally::PhotonTally(const Grid& grid)
     : grid_(grid),
       layout_{grid.shells, grid.time.bins},

@@ -75,7 +75,5 @@ class PhotonTally {
 /// series when k h < 2, the closed-form recurrence otherwise (relative error ~1e-15).
 void exp_moments(double k, double h, double J[5]);
 
-/// Integral over tau in [a, b] of exp(-k tau), stable for k b small (k >= 0).
-double exp_integral(double k, double a, double b);
 
 }  // namespace femto::diffusion

@@ -1,0 +1,430 @@
+#include "core/tissue/scene.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "core/error.h"
+#include "core/io/nifti.h"
+#include "media/label_grid_vdb.h"
+
+namespace femto::tissue {
+
+namespace {
+using Json = nlohmann::json;
+using Keys = std::vector<std::string>;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kMaxCells = 268435456.0;  // 2^28 label voxels (512 MiB of labels)
+constexpr double kMaxTallyCells =
+    68719476736.0;  // 2^36 fluence cells x gates: bounds every size computation
+constexpr int kMaxLabel = 65535;
+constexpr int kMaxNesting = 64;  // JSON depth, as for camera scenes
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string show(const Json& v) {
+  if (v.is_string()) return clip(Json(clip(v.get<std::string>(), 200)).dump());
+  return clip(v.dump());
+}
+
+// Reads one JSON object strictly: every key must be used, every value checked.
+class Reader {
+ public:
+  Reader(std::string source, std::string base)
+      : source_(std::move(source)), base_(std::move(base)) {}
+
+  std::string where(const std::string& path) const { return clip(source_, 200) + ": " + path; }
+  [[noreturn]] void fail(const std::string& path, const std::string& problem) const {
+    throw InputError(clip(source_, 200) + ": " + path + ": " + problem);
+  }
+  [[noreturn]] void fail(const std::string& path, const std::string& problem,
+                         const Json& got) const {
+    fail(path, problem + " (got " + show(got) + ")");
+  }
+
+  const Json& object(const Json& j, const std::string& path, const Keys& allowed) const {
+    if (!j.is_object()) fail(path, "must be an object", j);
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      bool ok = false;
+      for (const auto& k : allowed) ok = ok || k == it.key();
+      if (!ok) {
+        std::string list;
+        for (const auto& k : allowed) list += (list.empty() ? "'" : ", '") + k + "'";
+        fail(path + "/" + clip(it.key(), 40), "unknown key (expected one of " + list + ")");
+      }
+    }
+    return j;
+  }
+  double number(const Json& j, const std::string& path, double lo, double hi, bool lo_open = false,
+                bool hi_open = false) const {
+    if (!j.is_number()) fail(path, "must be a number", j);
+    const double x = j.get<double>();
+    const bool ok =
+        std::isfinite(x) && (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
+    if (!ok) {
+      std::string range = hi == kInf ? std::string(lo_open ? "must be > " : "must be >= ") + fmt(lo)
+                                     : std::string("must be in ") + (lo_open ? "(" : "[") +
+                                           fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]");
+      fail(path, range, j);
+    }
+    return x;
+  }
+  int64_t integer(const Json& j, const std::string& path, double lo, double hi) const {
+    const double x = number(j, path, lo, hi);
+    if (x != std::floor(x)) fail(path, "must be a whole number", j);
+    return static_cast<int64_t>(x);
+  }
+  Vec3 vec3(const Json& j, const std::string& path, bool nonzero = false) const {
+    if (!j.is_array() || j.size() != 3) fail(path, "must be [x, y, z]", j);
+    Vec3 v;
+    for (int i = 0; i < 3; ++i)
+      v[i] = number(j[static_cast<size_t>(i)], path + "/" + std::to_string(i), -1e9, 1e9);
+    if (nonzero && !(length(v) > 0)) fail(path, "must not be the zero vector", j);
+    return v;
+  }
+  std::array<int, 3> ints3(const Json& j, const std::string& path, int lo, int hi) const {
+    if (!j.is_array() || j.size() != 3) fail(path, "must be [nx, ny, nz]", j);
+    std::array<int, 3> v{};
+    for (size_t i = 0; i < 3; ++i)
+      v[i] = static_cast<int>(integer(j[i], path + "/" + std::to_string(i), lo, hi));
+    return v;
+  }
+  std::string string(const Json& j, const std::string& path, const Keys& options = {}) const {
+    if (!j.is_string()) fail(path, "must be a string", j);
+    const std::string s = j.get<std::string>();
+    if (options.empty()) return s;
+    for (const auto& o : options)
+      if (o == s) return s;
+    std::string list;
+    for (const auto& o : options) list += (list.empty() ? "\"" : ", \"") + o + "\"";
+    fail(path, "must be one of " + list, j);
+  }
+  bool boolean(const Json& j, const std::string& path) const {
+    if (!j.is_boolean()) fail(path, "must be true or false", j);
+    return j.get<bool>();
+  }
+  std::string file(const Json& j, const std::string& path) const {
+    const std::string f = string(j, path);
+    if (f.empty()) fail(path, "must name a file", j);
+    const std::filesystem::path p(f);
+    return p.is_absolute() || base_.empty() ? f : (std::filesystem::path(base_) / p).string();
+  }
+
+ private:
+  std::string source_, base_;
+};
+
+Json parse_strict(const std::string& text, const std::string& source) {
+  // Duplicate keys are errors (nlohmann keeps the last one silently).
+  std::vector<std::set<std::string>> keys;
+  const Json::parser_callback_t cb = [&](int depth, Json::parse_event_t ev, Json& parsed) {
+    if ((ev == Json::parse_event_t::object_start || ev == Json::parse_event_t::array_start) &&
+        depth >= kMaxNesting)
+      throw InputError(clip(source, 200) + ": values are nested more than " +
+                       std::to_string(kMaxNesting) +
+                       " levels deep; a tissue scene needs far fewer");
+    if (ev == Json::parse_event_t::object_start) keys.emplace_back();
+    if (ev == Json::parse_event_t::object_end) keys.pop_back();
+    if (ev == Json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second)
+      throw InputError(clip(source, 200) + ": duplicate key '" + clip(parsed.get<std::string>()) +
+                       "'");
+    return true;
+  };
+  try {
+    return Json::parse(text, cb, true, true);
+  } catch (const InputError&) {
+    throw;
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(clip(source, 200) + ": not valid JSON (" + clip(e.what(), 200) + ")");
+  }
+}
+
+void read_volume(const Reader& rd, const Json& j, const std::string& P, Setup& s) {
+  rd.object(j, P, {"shape", "fill", "voxel", "origin", "nifti", "vdb", "grid"});
+  const int sources =
+      (j.contains("fill") ? 1 : 0) + (j.contains("nifti") ? 1 : 0) + (j.contains("vdb") ? 1 : 0);
+  if (sources != 1)
+    rd.fail(P, "needs exactly one of \"fill\" (with \"shape\"), \"nifti\" or \"vdb\"", j);
+  LabelVolume& v = s.volume;
+  std::vector<uint16_t>& labels = v.labels;
+  if (j.contains("fill")) {
+    if (!j.contains("shape")) rd.fail(P + "/shape", "required with \"fill\"");
+    if (!j.contains("voxel")) rd.fail(P + "/voxel", "required with \"fill\"");
+    const auto n = rd.ints3(j["shape"], P + "/shape", 1, 100000);
+    const int label = static_cast<int>(rd.integer(j["fill"], P + "/fill", 1, kMaxLabel));
+    double cells = 1;
+    for (int a = 0; a < 3; ++a)
+      v.n[a] = n[static_cast<size_t>(a)], cells *= n[static_cast<size_t>(a)];
+    if (cells > kMaxCells) rd.fail(P + "/shape", "more than 2^28 voxels", j["shape"]);
+    labels.assign(static_cast<size_t>(cells), static_cast<uint16_t>(label));
+  } else if (j.contains("nifti")) {
+    for (const char* k : {"shape", "grid"})
+      if (j.contains(k)) rd.fail(P + "/" + k, "applies to \"fill\" / \"vdb\" volumes only");
+    const std::string path = rd.file(j["nifti"], P + "/nifti");
+    NiftiVolume nv;
+    try {
+      nv = read_nifti(path);
+    } catch (const InputError& e) {
+      rd.fail(P + "/nifti", e.what());
+    }
+    if (nv.dim[3] != 1)
+      rd.fail(P + "/nifti", path + ": a label volume has 3 dimensions (dim[4] = " +
+                                std::to_string(nv.dim[3]) + ")");
+    double cells = 1;
+    for (int a = 0; a < 3; ++a) v.n[a] = nv.dim[static_cast<size_t>(a)], cells *= v.n[a];
+    if (cells > kMaxCells) rd.fail(P + "/nifti", path + ": more than 2^28 voxels");
+    if (!j.contains("voxel")) {
+      const auto& pd = nv.pixdim;
+      if (!(pd[0] > 0) || std::abs(pd[0] - pd[1]) > 1e-6 * pd[0] ||
+          std::abs(pd[0] - pd[2]) > 1e-6 * pd[0])
+        rd.fail(P + "/nifti", path + ": voxels are " + fmt(pd[0]) + " x " + fmt(pd[1]) + " x " +
+                                  fmt(pd[2]) + " mm; cubic voxels are needed (or give \"voxel\")");
+      v.voxel = pd[0];
+    }
+    // NIfTI is x fastest; the label grid is z fastest.
+    labels.resize(static_cast<size_t>(cells));
+    for (int i = 0; i < v.n[0]; ++i)
+      for (int jj = 0; jj < v.n[1]; ++jj)
+        for (int k = 0; k < v.n[2]; ++k) {
+          const double x = nv.data[(static_cast<size_t>(k) * v.n[1] + jj) * v.n[0] + i];
+          if (x != std::floor(x) || x < 0 || x > kMaxLabel)
+            rd.fail(P + "/nifti", path + ": voxel (" + std::to_string(i) + ", " +
+                                      std::to_string(jj) + ", " + std::to_string(k) + ") holds " +
+                                      fmt(x) + "; labels are whole numbers 0 to 65535");
+          labels[v.index(i, jj, k)] = static_cast<uint16_t>(x);
+        }
+  } else {
+    if (j.contains("shape")) rd.fail(P + "/shape", "applies to \"fill\" volumes only");
+    const std::string path = rd.file(j["vdb"], P + "/vdb");
+    const std::string grid = j.contains("grid") ? rd.string(j["grid"], P + "/grid") : "labels";
+    const LabelGridData d = read_vdb_labels(path, grid, rd.where(P + "/vdb"));
+    for (int a = 0; a < 3; ++a) v.n[a] = d.n[static_cast<size_t>(a)];
+    v.voxel = d.voxel;
+    v.origin = d.origin;
+    labels.resize(d.labels.size());
+    for (size_t i = 0; i < labels.size(); ++i) {
+      if (d.labels[i] < 0 || d.labels[i] > kMaxLabel)
+        rd.fail(P + "/vdb",
+                path + ": label " + std::to_string(d.labels[i]) + " is outside 0 to 65535");
+      labels[i] = static_cast<uint16_t>(d.labels[i]);
+    }
+  }
+  if (j.contains("voxel")) v.voxel = rd.number(j["voxel"], P + "/voxel", 1e-6, 1e6);
+  if (j.contains("origin")) v.origin = rd.vec3(j["origin"], P + "/origin");
+}
+
+void read_labels(const Reader& rd, const Json& j, const std::string& P, double outside_n,
+                 Setup& s) {
+  if (!j.is_array() || j.empty())
+    rd.fail(P, "must be a non-empty array of {\"label\", \"mu_a\", \"mu_s\", \"g\", \"n\"}", j);
+  std::vector<bool> given;
+  std::vector<TissueOptics>& optics = s.volume.optics;
+  for (size_t i = 0; i < j.size(); ++i) {
+    const std::string Q = P + "/" + std::to_string(i);
+    const Json& e = rd.object(j[i], Q, {"label", "mu_a", "mu_s", "g", "n"});
+    for (const char* k : {"label", "mu_a", "mu_s", "g", "n"})
+      if (!e.contains(k)) rd.fail(Q + "/" + k, "required");
+    const size_t label = static_cast<size_t>(rd.integer(e["label"], Q + "/label", 1, kMaxLabel));
+    if (label >= optics.size()) optics.resize(label + 1), given.resize(label + 1, false);
+    if (given[label]) rd.fail(Q + "/label", "label given twice", e["label"]);
+    given[label] = true;
+    TissueOptics& o = optics[label];
+    o.mu_a = rd.number(e["mu_a"], Q + "/mu_a", 0, 1e6);
+    o.mu_s = rd.number(e["mu_s"], Q + "/mu_s", 0, 1e6);
+    o.g = rd.number(e["g"], Q + "/g", -1, 1, true, true);
+    o.n = rd.number(e["n"], Q + "/n", 1, 10);
+  }
+  optics[0] = TissueOptics{0, 0, 0, outside_n};
+  // Every label in the volume needs its optics.
+  std::vector<bool> seen(65536, false);
+  for (uint16_t l : s.volume.labels) seen[l] = true;
+  for (size_t l = 1; l < seen.size(); ++l)
+    if (seen[l] && (l >= given.size() || !given[l]))
+      rd.fail(P, "label " + std::to_string(l) +
+                     " occurs in the volume but has no optical properties here");
+}
+
+void read_source(const Reader& rd, const Json& j, const std::string& P, Source& src) {
+  rd.object(j, P,
+            {"type", "position", "direction", "waist", "radius", "cone_angle", "falloff_start",
+             "pulse", "specular"});
+  if (!j.contains("type")) rd.fail(P + "/type", "required");
+  const std::string type =
+      rd.string(j["type"], P + "/type", {"pencil", "gaussian", "disk", "isotropic", "spot"});
+  src.type = type == "pencil"     ? Source::Type::Pencil
+             : type == "gaussian" ? Source::Type::Gaussian
+             : type == "disk"     ? Source::Type::Disk
+             : type == "spot"     ? Source::Type::Spot
+                                  : Source::Type::Isotropic;
+  if (!j.contains("position")) rd.fail(P + "/position", "required");
+  src.position = rd.vec3(j["position"], P + "/position");
+  if (src.type == Source::Type::Isotropic) {
+    if (j.contains("direction")) rd.fail(P + "/direction", "an isotropic source has no direction");
+  } else {
+    if (!j.contains("direction")) rd.fail(P + "/direction", "required for a " + type + " source");
+    src.direction = normalize(rd.vec3(j["direction"], P + "/direction", true));
+  }
+  if (src.type == Source::Type::Gaussian) {
+    if (!j.contains("waist"))
+      rd.fail(P + "/waist", "required for a gaussian source (1/e^2 radius, mm)");
+    src.waist = rd.number(j["waist"], P + "/waist", 0, 1e6, true);
+  } else if (j.contains("waist")) {
+    rd.fail(P + "/waist", "applies to gaussian sources only");
+  }
+  if (src.type == Source::Type::Disk) {
+    if (!j.contains("radius")) rd.fail(P + "/radius", "required for a disk source (mm)");
+    src.radius = rd.number(j["radius"], P + "/radius", 0, 1e6, true);
+  } else if (j.contains("radius")) {
+    rd.fail(P + "/radius", "applies to disk sources only");
+  }
+  if (src.type == Source::Type::Spot) {  // the keys and defaults of the camera scenes' spot light
+    if (!j.contains("cone_angle"))
+      rd.fail(P + "/cone_angle", "required for a spot source (degrees)");
+    src.cone_angle_deg = rd.number(j["cone_angle"], P + "/cone_angle", 0, 90, true);
+    src.falloff_start_deg = 0.8 * src.cone_angle_deg;
+    if (j.contains("falloff_start"))
+      src.falloff_start_deg =
+          rd.number(j["falloff_start"], P + "/falloff_start", 0, src.cone_angle_deg);
+  } else {
+    for (const char* k : {"cone_angle", "falloff_start"})
+      if (j.contains(k)) rd.fail(P + "/" + k, "applies to spot sources only");
+  }
+  if (j.contains("pulse")) {
+    const Json& pl = rd.object(j["pulse"], P + "/pulse", {"fwhm", "offset"});
+    if (pl.contains("fwhm")) src.fwhm_ps = rd.number(pl["fwhm"], P + "/pulse/fwhm", 0, 1e9);
+    if (pl.contains("offset"))
+      src.offset_ps = rd.number(pl["offset"], P + "/pulse/offset", -1e9, 1e9);
+  }
+  if (j.contains("specular")) src.specular = rd.boolean(j["specular"], P + "/specular");
+}
+}  // namespace
+
+bool is_tissue_scene(const std::string& text) {
+  // Deeply nested values would make freeing the parsed value recurse past the stack.
+  struct TooDeep {};
+  const Json::parser_callback_t cb = [](int depth, Json::parse_event_t ev, Json&) {
+    if ((ev == Json::parse_event_t::object_start || ev == Json::parse_event_t::array_start) &&
+        depth >= kMaxNesting)
+      throw TooDeep{};
+    return true;
+  };
+  try {
+    const Json j = Json::parse(text, cb, false, true);
+    return j.is_object() && j.contains("tissue");
+  } catch (const TooDeep&) {
+    return false;  // the scene loader reports it
+  }
+}
+
+Setup load_tissue_scene(const std::string& text, const std::string& source,
+                        const std::string& base_dir) {
+  const Reader rd(source, base_dir);
+  const Json root = parse_strict(text, source);
+  rd.object(root, "", {"tissue"});
+  const std::string P = "/tissue";
+  const Json& t = rd.object(
+      root["tissue"], P,
+      {"volume", "labels", "outside_n", "boundary", "absorption", "source", "time", "fluence",
+       "faces", "detectors", "detected_photons", "photons", "seed", "batches"});
+  for (const char* k : {"volume", "labels", "source", "time"})
+    if (!t.contains(k)) rd.fail(P + "/" + k, "required");
+  Setup s;
+  read_volume(rd, t["volume"], P + "/volume", s);
+  const double outside_n =
+      t.contains("outside_n") ? rd.number(t["outside_n"], P + "/outside_n", 1, 10) : 1.0;
+  s.volume.optics.assign(1, TissueOptics{});
+  read_labels(rd, t["labels"], P + "/labels", outside_n, s);
+  if (t.contains("boundary"))
+    s.fresnel = rd.string(t["boundary"], P + "/boundary", {"fresnel", "matched"}) == "fresnel";
+  if (t.contains("absorption"))
+    s.absorption =
+        rd.string(t["absorption"], P + "/absorption", {"weighted", "analog"}) == "weighted"
+            ? Absorption::Weighted
+            : Absorption::Analog;
+  read_source(rd, t["source"], P + "/source", s.source);
+
+  const Json& tm = rd.object(t["time"], P + "/time", {"t_start", "bin_width", "bins"});
+  for (const char* k : {"bin_width", "bins"})
+    if (!tm.contains(k)) rd.fail(P + "/time/" + k, "required");
+  if (tm.contains("t_start"))
+    s.time.t_start_ps = rd.number(tm["t_start"], P + "/time/t_start", -1e9, 1e9);
+  s.time.bin_width_ps = rd.number(tm["bin_width"], P + "/time/bin_width", 1e-6, 1e9);
+  s.time.bins = static_cast<int>(rd.integer(tm["bins"], P + "/time/bins", 1, 100000));
+
+  // Fluence volume: over the label grid unless given its own grid.
+  s.fluence_grid.origin = s.volume.origin;
+  for (int a = 0; a < 3; ++a) {
+    s.fluence_grid.n[a] = s.volume.n[a];
+    s.fluence_grid.size[a] = s.volume.n[a] * s.volume.voxel;
+  }
+  if (t.contains("fluence")) {
+    const Json& f = t["fluence"];
+    if (f.is_boolean()) {
+      s.fluence = f.get<bool>();
+    } else {
+      rd.object(f, P + "/fluence", {"resolution", "origin", "size", "stderr"});
+      if (f.contains("resolution")) {
+        const auto n = rd.ints3(f["resolution"], P + "/fluence/resolution", 1, 100000);
+        for (int a = 0; a < 3; ++a) s.fluence_grid.n[a] = n[static_cast<size_t>(a)];
+      }
+      if (f.contains("origin")) s.fluence_grid.origin = rd.vec3(f["origin"], P + "/fluence/origin");
+      if (f.contains("size")) {
+        s.fluence_grid.size = rd.vec3(f["size"], P + "/fluence/size");
+        for (int a = 0; a < 3; ++a)
+          if (!(s.fluence_grid.size[a] > 0))
+            rd.fail(P + "/fluence/size", "every extent must be > 0", f["size"]);
+      }
+      if (f.contains("stderr")) s.fluence_stderr = rd.boolean(f["stderr"], P + "/fluence/stderr");
+    }
+  }
+  if (s.fluence) {
+    const double cells =
+        static_cast<double>(s.fluence_grid.n[0]) * s.fluence_grid.n[1] * s.fluence_grid.n[2];
+    if (cells * s.time.bins > kMaxTallyCells)
+      rd.fail(P + "/fluence",
+              "a fluence volume of " + fmt(cells) + " voxels x " + std::to_string(s.time.bins) +
+                  " gates is above the limit of 2^36 values; lower its resolution or the gates");
+  }
+  if (t.contains("faces")) s.faces = rd.boolean(t["faces"], P + "/faces");
+  if (t.contains("detectors")) {
+    const Json& d = t["detectors"];
+    if (!d.is_array()) rd.fail(P + "/detectors", "must be an array", d);
+    for (size_t i = 0; i < d.size(); ++i) {
+      const std::string Q = P + "/detectors/" + std::to_string(i);
+      const Json& e = rd.object(d[i], Q, {"position", "radius", "na"});
+      for (const char* k : {"position", "radius"})
+        if (!e.contains(k)) rd.fail(Q + "/" + k, "required");
+      Detector det;
+      det.center = rd.vec3(e["position"], Q + "/position");
+      det.radius = rd.number(e["radius"], Q + "/radius", 0, 1e6, true);
+      if (e.contains("na")) det.na = rd.number(e["na"], Q + "/na", 0, 10, true);
+      s.detectors.push_back(det);
+    }
+  }
+  if (t.contains("detected_photons")) {
+    const Json& d = rd.object(t["detected_photons"], P + "/detected_photons", {"save", "max"});
+    if (d.contains("save")) s.save_detected = rd.boolean(d["save"], P + "/detected_photons/save");
+    if (d.contains("max"))
+      s.max_detected =
+          static_cast<uint64_t>(rd.integer(d["max"], P + "/detected_photons/max", 0, 1e9));
+  }
+  if (t.contains("photons"))
+    s.photons = static_cast<uint64_t>(rd.integer(t["photons"], P + "/photons", 1, 1e12));
+  if (t.contains("seed"))
+    s.seed = static_cast<uint64_t>(rd.integer(t["seed"], P + "/seed", 0, 9007199254740992.0));
+  if (t.contains("batches"))
+    s.batches = static_cast<int>(rd.integer(t["batches"], P + "/batches", 1, 1000));
+  if (s.fluence_stderr && s.batches < 2)
+    rd.fail(P + "/batches", "standard errors (/tissue/fluence/stderr) need at least 2 batches",
+            t["batches"]);
+  return s;
+}
+
+}  // namespace femto::tissue

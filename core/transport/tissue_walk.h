@@ -1,0 +1,265 @@
+#pragma once
+// The photon random walk of tissue optics and of `femto diffusion`, written once: a step moves a
+// photon along one straight piece (to its next scattering, to a voxel face where the label
+// changes, or to the window end) and describes that piece as a Segment for the tallies. What the
+// space looks like is a template parameter (an unbounded homogeneous medium, or a labelled voxel
+// grid with Fresnel interfaces), so the hot loop has no virtual calls.
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+#include "core/bsdf/fresnel.h"
+#include "core/constants.h"
+#include "core/rng.h"
+#include "core/transport/photon.h"
+#include "core/transport/tissue_volume.h"
+#include "media/phase_hg.h"
+
+namespace femto {
+
+/// How absorption is simulated. Weighted: flights between scatterings (mu_s), the weight decays
+/// as exp(-mu_a s) along the path (implicit absorption, as MCX does; lower variance, and the
+/// random walk does not depend on mu_a, which is what makes re-weighting exact). Analog: flights
+/// between collisions (mu_t); a collision absorbs the photon with probability mu_a / mu_t.
+enum class Absorption { Weighted, Analog };
+
+/// What ended a step.
+enum class StepEvent {
+  Scattered,  ///< scattered into a new direction
+  Absorbed,   ///< analog absorption at a collision (the photon's weight is in Segment::absorbed)
+  Face,       ///< crossed into the neighbouring voxel
+  Reflected,  ///< Fresnel (or total internal) reflection at a voxel face
+  Escaped,    ///< entered label 0 (outside): the photon has left the tissue
+  WindowEnd,  ///< reached the end of the time window, still in the tissue
+  Lost        ///< an endless flight (unbounded clear medium); the whole weight was absorbed
+};
+
+/// Per-label coefficients as the walk uses them.
+struct WalkOptics {
+  double mu_a = 0, mu_s = 0, mu_t = 0, g = 0, n = 1;
+  double v = kSpeedOfLight;  ///< c / n, mm/ps
+  static WalkOptics of(const TissueOptics& o) {
+    return {o.mu_a, o.mu_s, o.mu_a + o.mu_s, o.g, o.n, kSpeedOfLight / o.n};
+  }
+};
+
+struct WalkSettings {
+  Absorption absorption = Absorption::Weighted;
+  double t_end = std::numeric_limits<double>::infinity();  ///< window end, ps: photons stop there
+};
+
+/// Regular-grid traversal (3-D DDA, Amanatides & Woo) along x + d s from voxel `cell`: the
+/// distance to the next face on each axis, advanced incrementally (no division per voxel).
+struct VoxelDda {
+  int cell[3] = {0, 0, 0}, step[3] = {0, 0, 0};
+  double t_max[3] = {0, 0, 0}, t_delta[3] = {0, 0, 0};
+
+  VoxelDda(const Vec3& x, const Vec3& d, const int c[3], const Vec3& origin, const Vec3& h) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+      cell[a] = c[a];
+      if (d[a] == 0) {
+        step[a] = 0, t_max[a] = kInf, t_delta[a] = kInf;
+        continue;
+      }
+      step[a] = d[a] > 0 ? 1 : -1;
+      const double face = origin[a] + (c[a] + (d[a] > 0 ? 1 : 0)) * h[a];
+      t_max[a] = std::max(0.0, (face - x[a]) / d[a]);
+      t_delta[a] = h[a] / std::abs(d[a]);
+    }
+  }
+  /// The axis of the nearest face.
+  int axis() const {
+    return t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+  }
+  void advance(int a) {
+    cell[a] += step[a];
+    t_max[a] += t_delta[a];
+  }
+};
+
+/// An unbounded homogeneous medium (femto diffusion): no faces, one label.
+class UnboundedSpace {
+ public:
+  explicit UnboundedSpace(const TissueOptics& o) : o_(WalkOptics::of(o)) {}
+  const WalkOptics& optics(int) const { return o_; }
+  double distance_to_interface(const Photon& p, double, int&, int end_cell[3]) const {
+    for (int a = 0; a < 3; ++a) end_cell[a] = p.cell[a];
+    return std::numeric_limits<double>::infinity();
+  }
+  StepEvent cross(Photon&, int, Rng&) const { return StepEvent::Face; }  // never reached
+
+ private:
+  WalkOptics o_;
+};
+
+/// A labelled voxel grid. Where the label changes across a voxel face (another tissue, or label
+/// 0 at the outer surface) and the refractive index differs, the photon is reflected with the
+/// Fresnel reflectance of unpolarised light (total internal reflection included) or refracted by
+/// Snell's law, when `fresnel`; otherwise every face is index-matched (straight through).
+class LabelSpace {
+ public:
+  LabelSpace(const LabelVolume& volume, bool fresnel) : vol_(volume), fresnel_(fresnel) {
+    for (const TissueOptics& o : volume.optics) optics_.push_back(WalkOptics::of(o));
+  }
+  const LabelVolume& volume() const { return vol_; }
+  const WalkOptics& optics(int label) const { return optics_[static_cast<size_t>(label)]; }
+
+  /// Distance along p.d to the first voxel face where the label changes, if it comes before
+  /// s_stop (else +inf); `axis` is that face's axis. end_cell: the voxel holding the end of the
+  /// piece (the last voxel before that face, or the voxel at s_stop). Faces between voxels of
+  /// the same label are crossed here, without a step of the walk.
+  double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3]) const {
+    const VoxelDda dda(p.x, p.d, p.cell, vol_.origin, Vec3(vol_.voxel));
+    // Scalars rather than arrays indexed by the moving axis keep the march in registers; the
+    // voxel's index into the labels moves by a fixed stride per axis.
+    int cx = dda.cell[0], cy = dda.cell[1], cz = dda.cell[2];
+    double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
+    const ptrdiff_t sx = dda.step[0] * static_cast<ptrdiff_t>(vol_.n[1]) * vol_.n[2];
+    const ptrdiff_t sy = dda.step[1] * static_cast<ptrdiff_t>(vol_.n[2]), sz = dda.step[2];
+    const uint16_t* labels = vol_.labels.data();
+    ptrdiff_t i = static_cast<ptrdiff_t>(vol_.index(cx, cy, cz));  // a tissue voxel: in the grid
+    const int label = p.label;
+    double s = std::numeric_limits<double>::infinity();
+    while (true) {
+      if (tx < ty && tx < tz) {  // the same choice as VoxelDda::axis()
+        if (tx >= s_stop) break;
+        const int c = cx + dda.step[0];
+        if (c < 0 || c >= vol_.n[0] || labels[i + sx] != label) {
+          s = tx, axis = 0;
+          break;
+        }
+        cx = c, i += sx, tx += dda.t_delta[0];
+      } else if (!(tx < ty) && ty < tz) {
+        if (ty >= s_stop) break;
+        const int c = cy + dda.step[1];
+        if (c < 0 || c >= vol_.n[1] || labels[i + sy] != label) {
+          s = ty, axis = 1;
+          break;
+        }
+        cy = c, i += sy, ty += dda.t_delta[1];
+      } else {
+        if (tz >= s_stop) break;
+        const int c = cz + dda.step[2];
+        if (c < 0 || c >= vol_.n[2] || labels[i + sz] != label) {
+          s = tz, axis = 2;
+          break;
+        }
+        cz = c, i += sz, tz += dda.t_delta[2];
+      }
+    }
+    end_cell[0] = cx, end_cell[1] = cy, end_cell[2] = cz;
+    return s;
+  }
+
+  /// The photon is on the face of its voxel on `axis`, facing another label: reflect, or move
+  /// into the neighbour.
+  StepEvent cross(Photon& p, int axis, Rng& rng) const {
+    const int step = p.d[axis] > 0 ? 1 : -1;
+    p.x[axis] = vol_.origin[axis] + (p.cell[axis] + (step > 0 ? 1 : 0)) * vol_.voxel;  // no drift
+    p.face_axis = axis;
+    int next[3] = {p.cell[0], p.cell[1], p.cell[2]};
+    next[axis] += step;
+    const int label = vol_.label_at(next[0], next[1], next[2]);
+    const double n1 = optics_[static_cast<size_t>(p.label)].n,
+                 n2 = optics_[static_cast<size_t>(label)].n;
+    if (fresnel_ && n1 != n2) {
+      const double cos_i = std::abs(p.d[axis]);
+      const Fresnel fr = fresnel_dielectric(cos_i, n2 / n1);
+      if (fr.R >= 1.0 || rng.uniform() < fr.R) {
+        p.d[axis] = -p.d[axis];
+        return StepEvent::Reflected;
+      }
+      // Snell: tangential components scale by n1 / n2, the normal one becomes cos_t.
+      const double r = n1 / n2;
+      Vec3 d = p.d * r;
+      d[axis] = step * fr.cos_t;
+      p.d = normalize(d);
+    }
+    p.cell[0] = next[0], p.cell[1] = next[1], p.cell[2] = next[2];
+    p.label = label;
+    if (label == 0) {
+      p.alive = false;
+      return StepEvent::Escaped;
+    }
+    return StepEvent::Face;
+  }
+
+ private:
+  const LabelVolume& vol_;
+  bool fresnel_;
+  std::vector<WalkOptics> optics_;
+};
+
+/// 1 - exp(-x) for x >= 0, to a relative error below 1e-13, cheaper than std::expm1: a series
+/// for small x, where 1 - exp(-x) would cancel.
+inline double one_minus_exp(double x) {
+  if (x < 1e-3) return x * (1 - x * (0.5 - x * (1.0 / 6 - x * (1.0 / 24))));
+  return 1 - std::exp(-x);
+}
+
+/// One step of the walk: moves p along a straight piece, fills `seg` with it (weight, absorbed
+/// energy, time, label and voxel) and returns what ended it.
+template <class Space>
+StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& rng, Segment& seg) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const WalkOptics& o = space.optics(p.label);
+  const bool analog = ws.absorption == Absorption::Analog;
+  const double rate = analog ? o.mu_t : o.mu_s;
+  if (p.tau_left < 0) p.tau_left = -std::log(1 - rng.uniform());  // 1 - u is exact
+  int axis = 0, end_cell[3];
+  const double s_event = rate > 0 ? p.tau_left / rate : kInf;
+  const double s_window = (ws.t_end - p.t) * o.v;
+  const double s_face = space.distance_to_interface(p, std::min(s_event, s_window), axis, end_cell);
+  StepEvent ev;
+  double s;
+  if (s_face < s_event && s_face < s_window) {
+    s = s_face, ev = StepEvent::Face;
+  } else if (s_event <= s_window) {
+    s = s_event, ev = StepEvent::Scattered;
+  } else {
+    s = std::max(0.0, s_window), ev = StepEvent::WindowEnd;
+  }
+  seg.x0 = p.x, seg.d = p.d, seg.t0 = p.t, seg.v = o.v, seg.w0 = p.w;
+  seg.k = analog ? 0.0 : o.mu_a * o.v;
+  seg.scatterings = p.scatterings, seg.label = p.label;
+  seg.cell[0] = p.cell[0], seg.cell[1] = p.cell[1], seg.cell[2] = p.cell[2];
+  seg.duration = s / o.v;
+  seg.distance = s;
+  if (!std::isfinite(s)) {  // an endless flight: everything is absorbed on the way (if mu_a > 0)
+    seg.absorbed = seg.k > 0 ? p.w : 0.0;
+    p.w -= seg.absorbed;
+    p.alive = false;
+    p.t = kInf;
+    return StepEvent::Lost;
+  }
+  const double x = seg.k * seg.duration;
+  seg.absorbed = x > 0 ? p.w * one_minus_exp(x) : 0.0;
+  p.w -= seg.absorbed;  // absorbed + carried = w0 exactly, up to one rounding
+  p.x += p.d * s;
+  p.cell[0] = end_cell[0], p.cell[1] = end_cell[1], p.cell[2] = end_cell[2];
+  if (ev == StepEvent::WindowEnd) {
+    p.t = ws.t_end;
+    p.tau_left -= rate * s;
+    p.alive = false;
+    return ev;
+  }
+  p.t += seg.duration;
+  if (ev == StepEvent::Face) {
+    p.tau_left = std::max(0.0, p.tau_left - rate * s);
+    return space.cross(p, axis, rng);
+  }
+  p.tau_left = -1;
+  if (analog && rng.uniform() * o.mu_t < o.mu_a) {
+    seg.absorbed += p.w;
+    p.w = 0;
+    p.alive = false;
+    return StepEvent::Absorbed;
+  }
+  p.d = hg_sample(p.d, o.g, rng.uniform(), rng.uniform()).dir;
+  ++p.scatterings;
+  return StepEvent::Scattered;
+}
+
+}  // namespace femto
