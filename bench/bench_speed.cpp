@@ -67,11 +67,11 @@ int main(int argc, char** argv) {
   }
   const SceneDesc base = load_scene_string(kScene, "<bench fog box>", ".");
   const Config configs[] = {
-      {"default (mis + mis, phase)", base.media[0].sampling, base.media[0].connection,
+      {"default (mfp + auto)", base.media[0].sampling, base.media[0].connection,
        base.media[0].direction},
-      {"mfp + mis", DistanceSampling::Mfp, ConnectionSampling::Mis, DirectionSampling::Phase},
-      {"mis + equiangular", DistanceSampling::Mis, ConnectionSampling::Equiangular,
+      {"mis + mis (old default)", DistanceSampling::Mis, ConnectionSampling::Mis,
        DirectionSampling::Phase},
+      {"mfp + mis", DistanceSampling::Mfp, ConnectionSampling::Mis, DirectionSampling::Phase},
       {"mfp + line_to_point", DistanceSampling::Mfp, ConnectionSampling::LineToPoint,
        DirectionSampling::Phase},
       {"mfp + equiangular", DistanceSampling::Mfp, ConnectionSampling::Equiangular,
