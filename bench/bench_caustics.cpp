@@ -15,11 +15,13 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "core/default_scene.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
 
 using namespace femto;
+using femto::bench::cpu_model;
 
 namespace {
 
@@ -30,14 +32,6 @@ struct Options {
   int x0 = 96, y0 = 136, x1 = 160, y1 = 180;  ///< crop (pixels, end exclusive)
   uint64_t seed = 7;
 };
-
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
-}
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();

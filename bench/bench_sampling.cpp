@@ -21,20 +21,15 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
 
 using namespace femto;
+using femto::bench::cpu_model;
+using femto::bench::median;
 
 namespace {
-
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
-}
 
 struct BenchScene {
   const char* name;
@@ -71,12 +66,6 @@ struct Config {
   ConnectionSampling connection;
   bool is_default;
 };
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0;

@@ -12,10 +12,13 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
 
 using namespace femto;
+using femto::bench::cpu_model;
+using femto::bench::median;
 
 namespace {
 
@@ -28,25 +31,12 @@ const char* kScene = R"({
   "lights": [ { "type": "point", "position": [2, 3, 1], "intensity": 100 } ]
 })";
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
-}
-
 struct Config {
   const char* name;
   DistanceSampling distance;
   ConnectionSampling connection;
   DirectionSampling direction;
 };
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 }  // namespace
 

@@ -10,21 +10,13 @@
 #include <fstream>
 #include <string>
 
+#include "bench/bench_util.h"
 #include "core/scene_loader.h"
 #include "core/tissue/scene.h"
 #include "core/tissue/simulate.h"
 
 using namespace femto;
-
-namespace {
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
-}
-}  // namespace
+using femto::bench::cpu_model;
 
 int main(int argc, char** argv) {
   const std::string path = argc > 1 ? argv[1] : "data/scenes/cube60.json";
