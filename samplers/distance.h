@@ -5,10 +5,14 @@
 
 namespace femto {
 
+/// Inverse CDF of the unit exponential, -log(1 - u), u in [0,1). For the 53-bit uniforms of
+/// Rng (multiples of 2^-53) 1 - u is exact, so log is as accurate as log1p and ~3x cheaper.
+inline double unit_exponential(double u) { return -std::log(1.0 - u); }
+
 /// Inverse CDF of the exponential distribution; u in [0,1). Returns +inf when sigma_t == 0.
 inline double sample_exponential(double sigma_t, double u) {
   if (!(sigma_t > 0.0)) return std::numeric_limits<double>::infinity();
-  return -std::log1p(-u) / sigma_t;
+  return unit_exponential(u) / sigma_t;
 }
 
 /// Density of sample_exponential at s >= 0.

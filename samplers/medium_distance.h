@@ -17,6 +17,7 @@
 #include "core/scene_desc.h"
 #include "media/grid_medium.h"
 #include "media/poly3.h"
+#include "samplers/distance.h"
 
 namespace femto {
 
@@ -65,7 +66,7 @@ class ConstantSegments {
 template <class Segments>
 DistanceEvent sample_distance(Segments& segments, const DistanceStrategy& st, double u_dist) {
   const bool use_mfp = st.kind != DistanceSampling::TimeUniform;
-  const double target = use_mfp ? -std::log1p(-u_dist) : -std::log1p(-u_dist) / st.lambda;
+  const double target = use_mfp ? unit_exponential(u_dist) : unit_exponential(u_dist) / st.lambda;
   DistanceEvent ev;
   MediumSegment seg;
   while (segments.next(seg)) {
@@ -104,8 +105,8 @@ struct DistancePair {
 
 template <class Segments>
 DistancePair sample_distance_mis(Segments& segments, const DistanceStrategy& st, double u_mfp, double u_tu) {
-  const double tau_target = -std::log1p(-u_mfp);
-  const double opl_target = -std::log1p(-u_tu) / st.lambda;
+  const double tau_target = unit_exponential(u_mfp);
+  const double opl_target = unit_exponential(u_tu) / st.lambda;
   DistancePair out;
   double tau = 0, opl = 0;
   MediumSegment seg;

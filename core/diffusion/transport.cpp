@@ -24,7 +24,7 @@ VoxelTransport::VoxelTransport(const GridMedium& grid, double g, const Vec3& ori
     : grid_(grid), g_(g), origin_(origin) {}
 
 Segment VoxelTransport::advance(Photon& p, Rng& rng) const {
-  if (p.tau_left < 0) p.tau_left = -std::log1p(-rng.uniform());
+  if (p.tau_left < 0) p.tau_left = unit_exponential(rng.uniform());
   Segment seg;
   seg.x0 = p.x, seg.d = p.d, seg.t0 = p.t, seg.w0 = p.w, seg.k = 0.0;
   seg.scatterings = p.scatterings;

@@ -10,6 +10,7 @@
 #include "core/integrators/volpath.h"
 #include "media/phase_hg.h"
 #include "samplers/angular.h"
+#include "samplers/distance.h"
 #include "samplers/equiangular.h"
 #include "samplers/line_to_point.h"
 
@@ -50,7 +51,7 @@ VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& m
   mix.t = t;
   mix.eta = med.eta_at(x);
   // The segment length the next distance draw u gives at x's own coefficients.
-  const double e = -std::log1p(-u);
+  const double e = unit_exponential(u);  // the same draw as the tracker's
   if (med.strategy.kind == DistanceSampling::TimeUniform) {
     mix.r_aux = e / (med.strategy.lambda * mix.eta);
   } else {
