@@ -224,6 +224,21 @@ int main(int argc, char** argv) {
       // 20 mm block of tissue: mu_s = 10/mm, g = 0.9 (mu_s' = 1/mm), mu_a = 0.01/mm, n = 1.37,
       // 150 ps.
       {"tissue", box_scene(10, 0.01, 10.0, 0.9, 1.37, 1.0), 4},
+      // A closed 400 mm room of grey walls (albedo 0.8) in very thin fog (mean free path 2 m),
+      // a point light, the camera inside; a 12 ns window: the late frames are light that has
+      // bounced and scattered many times (the regime where time-uniform sampling should pay).
+      {"thin fog room, long window", R"({
+        "camera": { "type": "perspective", "position": [0, 0, 150], "look_at": [0, 0, 0],
+                    "fov": 60, "resolution": [32, 32] },
+        "time": { "t_start": 0, "bin_width": 80, "bins": 150 },
+        "media": { "fog": { "type": "homogeneous", "sigma_a": 0.00005, "sigma_s": 0.00045,
+                            "g": 0.3 } },
+        "medium": "fog",
+        "shapes": [ { "type": "box", "min": [-200, -200, -200], "max": [200, 200, 200],
+                      "material": { "type": "diffuse", "albedo": 0.8 } } ],
+        "lights": [ { "type": "point", "position": [40, 60, -30], "intensity": 1000 } ]
+      })",
+       16},
   };
   const std::string cloud = "data/volumes/cloud.vdb";
   if (std::filesystem::exists(cloud)) {
