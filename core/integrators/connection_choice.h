@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/lights.h"
 #include "core/vec3.h"
 #include "media/medium.h"
 
@@ -36,7 +37,8 @@ inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, doub
                                const Vec3& p) {
   const double mfp = sigma_t > 0 ? 1.0 / sigma_t : std::numeric_limits<double>::infinity();
   const double spread = std::fmin(s_full, mfp);
-  if (!(spread < std::numeric_limits<double>::infinity())) return true;  // clear, endless: no collisions to use
+  // A clear, endless segment has no collisions to lean on.
+  if (!(spread < std::numeric_limits<double>::infinity())) return true;
   const Vec3 l = p - o;
   const double delta = dot(l, d);
   double w;
@@ -47,6 +49,14 @@ inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, doub
   else
     w = std::sqrt(std::fmax(length_squared(l) - delta * delta, 0.0));
   return w < kConnectionPeakFraction * spread;
+}
+
+/// The auto rule for one light: spot lights always connect (their cone), point lights by
+/// connect_segment_to. Both the segment estimate and the collision vertices ask this.
+inline bool auto_connects(const Light& light, const Vec3& o, const Vec3& d, double s_full,
+                          double sigma_t) {
+  return light.type == Light::Type::Spot ||
+         connect_segment_to(o, d, s_full, sigma_t, light.position);
 }
 
 }  // namespace femto

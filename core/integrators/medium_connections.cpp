@@ -134,8 +134,8 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
   if (!is_point_like(L)) return;  // area lights and lasers: next-event estimation at collisions
   const Vec3& p = L.position;
   const ConnectionSampling kind = med.connection;
-  if (kind == ConnectionSampling::Auto && L.type != Light::Type::Spot &&
-      !connect_segment_to(ray.o, ray.d, s_surf, spread_sigma_t(med, ray.o), p))
+  if (kind == ConnectionSampling::Auto &&
+      !auto_connects(L, ray.o, ray.d, s_surf, spread_sigma_t(med, ray.o)))
     return;  // collision next-event estimation's share
   // No vertex whose path passes the cut-off: with eta >= 1 the time of s and its connection is at
   // least (s + d) / c with d >= s - |p - o|; an unwarped camera segment counts only d.

@@ -51,8 +51,7 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
 
 bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
   if (!active) return false;
-  return all || light.type == Light::Type::Spot ||
-         connect_segment_to(ray.o, ray.d, s_surf, sigma_t, light.position);
+  return all || auto_connects(light, ray.o, ray.d, s_surf, sigma_t);
 }
 
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
