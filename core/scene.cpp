@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/constants.h"
+#include "core/medium_nesting.h"
 #include "media/volume_data.h"
 
 namespace femto {
@@ -35,8 +36,9 @@ Scene::Scene(SceneDesc desc)
     media_.push_back(Medium{});  // vacuum
     outside_ = static_cast<int>(media_.size()) - 1;
   }
-  inside_.assign(desc_.shapes.size(), outside_);
-  for (size_t i = 0; i < desc_.shapes.size(); ++i) {
+  const size_t n = desc_.shapes.size();
+  inside_.assign(n, outside_);
+  for (size_t i = 0; i < n; ++i) {
     const ShapeDesc& sh = desc_.shapes[i];
     if (sh.material.type == MaterialDesc::Type::None) has_null_boundaries_ = true;
     if (sh.interior_medium >= 0) {
@@ -48,6 +50,17 @@ Scene::Scene(SceneDesc desc)
       inside_[i] = static_cast<int>(media_.size()) - 1;
     }
   }
+  // Media nest: a shape's outside is the inside of the innermost medium shape around it, and a
+  // shape that bounds no medium has that medium on both sides.
+  const std::vector<int> enclosing = enclosing_shapes(desc_);
+  outside_of_.assign(n, outside_);
+  for (size_t i = 0; i < n; ++i) {
+    const int e = enclosing[i];
+    if (e >= 0) outside_of_[i] = inside_[static_cast<size_t>(e)];
+    if (!bounds_a_medium(desc_.shapes[i])) inside_[i] = outside_of_[i];
+  }
+  const int around_camera = innermost_shape_at(desc_, enclosing, desc_.camera.position);
+  camera_medium_ = around_camera >= 0 ? inside_[static_cast<size_t>(around_camera)] : outside_;
   const Vec3 lo = geometry_.bounds_min(), hi = geometry_.bounds_max();
   const double extent = std::max({max_abs_component(lo), max_abs_component(hi),
                                   max_abs_component(desc_.camera.position), 1.0});

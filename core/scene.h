@@ -24,12 +24,21 @@ class Scene {
   const LightSet& lights() const { return lights_; }
   const Camera& camera() const { return camera_; }
 
-  /// Media of all regions; index outside_medium() is the space outside all shapes (vacuum by
+  /// Media of all regions; index global_medium() is the space outside all shapes (vacuum by
   /// default). A dielectric shape without a named medium gets a clear medium of its own eta.
   const std::vector<Medium>& media() const { return media_; }
-  int outside_medium() const { return outside_; }
+  int global_medium() const { return outside_; }
   /// Medium entered when a ray crosses shape i against its normal.
   int inside_medium(int shape) const { return inside_[static_cast<size_t>(shape)]; }
+  /// Medium entered when a ray crosses shape i along its normal: the inside of the innermost
+  /// shape around it (media nest), else the global medium.
+  int outside_medium(int shape) const { return outside_of_[static_cast<size_t>(shape)]; }
+  /// Medium on the far side of shape i from a ray travelling along d.
+  int medium_beyond(int shape, const Vec3& d, const Vec3& ng) const {
+    return dot(d, ng) < 0 ? inside_medium(shape) : outside_medium(shape);
+  }
+  /// Medium the camera sits in (the innermost closed medium shape around it).
+  int camera_medium() const { return camera_medium_; }
   /// Whether any shape is an index-matched boundary (shadow rays must then walk through them).
   bool has_null_boundaries() const { return has_null_boundaries_; }
   /// Offset used to leave a surface without hitting it again, mm.
@@ -43,7 +52,9 @@ class Scene {
   std::vector<Medium> media_;
   std::vector<std::unique_ptr<GridMedium>> grids_;
   std::vector<int> inside_;
+  std::vector<int> outside_of_;
   int outside_ = 0;
+  int camera_medium_ = 0;
   double ray_eps_ = 1e-5;
   bool has_null_boundaries_ = false;
 };

@@ -15,6 +15,7 @@
 
 #include "core/constants.h"
 #include "core/error.h"
+#include "core/medium_nesting.h"
 #include "core/obj_loader.h"
 
 namespace femto {
@@ -268,6 +269,7 @@ class Loader {
     if (const Json* s = find(root, "shapes")) shapes(*s, scene);
     if (const Json* l = find(root, "lights")) lights(*l, scene);
     if (const Json* r = find(root, "render")) render(*r, scene.integrator);
+    enclosing_shapes(scene);  // media may nest but not overlap: refused here, before any work
 
     const bool emissive = std::any_of(scene.shapes.begin(), scene.shapes.end(),
                                       [](const ShapeDesc& s) { return s.emissive; });

@@ -96,14 +96,17 @@ inline std::vector<std::vector<double>> cells(const std::vector<TransientFilm>& 
 /// standard errors; the sum of z^2 over them (a small bias shared by many cells that no single
 /// cell shows) with p > 1e-3; and the resolution: an error of 4 x `resolution` in the total would
 /// be 4 combined standard errors.
+/// Cells with `skip[c]` set are left out.
 inline void require_agreement(const std::vector<std::vector<double>>& a,
                               const std::vector<std::vector<double>>& b, int min_cells,
-                              double resolution = 0.02) {
+                              double resolution = 0.02, const std::vector<bool>& skip = {}) {
   double peak = 0;
-  for (const auto& c : a) peak = std::max(peak, mean_se(c).mean);
+  for (size_t c = 0; c < a.size(); ++c)
+    if (!(c < skip.size() && skip[c])) peak = std::max(peak, mean_se(a[c]).mean);
   int compared = 0;
   double chi2 = 0, max_z = 0, total = 0, var_a = 0, var_b = 0;
   for (size_t c = 0; c < a.size(); ++c) {
+    if (c < skip.size() && skip[c]) continue;
     const MeanSE x = mean_se(a[c]), y = mean_se(b[c]);
     total += x.mean;
     var_a += x.se * x.se;

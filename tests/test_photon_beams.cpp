@@ -241,6 +241,32 @@ SceneDesc glass_in_fog(const std::string& lights, const std::string& extra_shape
                            "glass in fog", ".");
 }
 
+// Cells (as cells() numbers them) with a pixel whose camera rays meet the sphere (c, r): light
+// tracing cannot connect a vertex to the camera through smooth glass, so it misses what the
+// camera sees through the sphere (docs/outputs.md, "Integrators"); those cells are not compared.
+std::vector<bool> cells_seeing_sphere(const Scene& scene, const Vec3& c, double r, int block,
+                                      int group) {
+  const int w = scene.desc().camera.width, h = scene.desc().camera.height;
+  const int bx = (w + block - 1) / block, by = (h + block - 1) / block;
+  const int bt = (scene.desc().time.bins + group - 1) / group;
+  std::vector<bool> skip(static_cast<size_t>(bx * by * bt), false);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      bool sees = false;
+      for (int i = 0; i <= 4; ++i)
+        for (int j = 0; j <= 4; ++j) {
+          const Ray ray = scene.camera().generate_ray(x + 0.25 * i, y + 0.25 * j);
+          const Vec3 oc = c - ray.o;
+          const double along = dot(oc, ray.d);
+          sees = sees || (along > 0 && length_squared(oc - ray.d * along) < r * r);
+        }
+      if (!sees) continue;
+      for (int t = 0; t < bt; ++t)
+        skip[static_cast<size_t>(((y / block) * bx + x / block) * bt + t)] = true;
+    }
+  return skip;
+}
+
 }  // namespace
 
 // Catches: caustic beams or photons double-counting light that camera paths also find, or camera
@@ -263,7 +289,8 @@ TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog"
 
 // Catches: wrong normalisation or timing of caustic beams and photons (camera paths cannot reach
 // light -> glass -> fog from a point light; light tracing splats every fog and floor vertex to
-// the camera, which sees them directly).
+// the camera, which sees them directly), and fog around the nested glass sphere handled
+// differently by the two (the cells that see the sphere itself are left out, see above).
 TEST_CASE("hybrid agrees with light tracing on a volumetric caustic from a point light",
           "[beams][statistical]") {
   const SceneDesc d =
@@ -284,5 +311,6 @@ TEST_CASE("hybrid agrees with light tracing on a volumetric caustic from a point
     lt.push_back(render(scene, opt).film);
   }
   const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 64, 24, 1100, pd), 4, 2);
-  require_agreement(hy, cells(lt, 4, 2), 12);
+  const std::vector<bool> skip = cells_seeing_sphere(scene, {-5, 35, 0}, 12.5, 4, 2);
+  require_agreement(hy, cells(lt, 4, 2), 12, 0.02, skip);
 }

@@ -59,7 +59,10 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
         const RGB f = v.bsdf->f(v.wo, wi, TransportMode::Importance);
         if (f.is_black()) return true;
         const Vec3& ng = v.hit->ng;
-        const int m = out_side ? scene_.outside_medium() : scene_.inside_medium(v.hit->shape);
+        const int shape = v.hit->shape;
+        const int m = out_side == (v.wo.z > 0)
+                          ? v.medium
+                          : out_side ? scene_.outside_medium(shape) : scene_.inside_medium(shape);
         splat(v.p + ng * (out_side ? eps : -eps), m, w, dist - eps,
               v.beta * f * (std::abs(wi.z) * W), v.t_ps, v.sigma_ps, fx, fy, out, stats);
         return true;

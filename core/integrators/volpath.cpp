@@ -79,6 +79,7 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
 
 void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit,
                                                 const Frame& frame, const Vec3& wo, bool wo_outside,
+                                                int m_wo,
                                                 const RGB& beta, double t, Rng& rng,
                                                 PixelAccumulator& acc, PathStats& stats) const {
   const LightSet& lights = scene_.lights();
@@ -98,7 +99,10 @@ void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceH
   const RGB f = bsdf.f(wo, wi, TransportMode::Radiance);
   if (f.is_black()) return;
   const Vec3 x = wi_outside == wo_outside ? x_wo : hit.p + hit.ng * (wi_outside ? eps : -eps);
-  const int m = wi_outside ? scene_.outside_medium() : scene_.inside_medium(hit.shape);
+  // A reflected sample stays in the path's medium; a transmitted one is beyond the surface.
+  const int m = wi_outside == wo_outside ? m_wo
+                : wi_outside             ? scene_.outside_medium(hit.shape)
+                                         : scene_.inside_medium(hit.shape);
   // From the other side the light is nearer by the offset's projection (else the occlusion
   // test would reach the light's own surface).
   const double dist = ls.dist - dot(x - x_wo, ls.wi);
@@ -118,7 +122,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   const double eps = scene_.ray_epsilon();
   ++stats.paths;
 
-  int m = scene_.outside_medium();
+  int m = scene_.camera_medium();
   RGB beta(1.0);
   double t = 0.0;                 // time of flight from the sensor to the current vertex, ps
   bool on_camera_segment = true;  // unwarp mode drops the time of the sensor's own segment
@@ -242,7 +246,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       // Index-matched boundary: change medium, keep going straight.
       ++stats.null_crossings;
       if (++null_crossings > kMaxNullCrossings) break;
-      m = front ? scene_.inside_medium(hit.shape) : scene_.outside_medium();
+      m = front ? scene_.inside_medium(hit.shape) : scene_.outside_medium(hit.shape);
       ray.o = hit.p + ray.d * eps;
       continue;
     }
@@ -254,14 +258,14 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     }
     ++depth;
     const Bsdf bsdf = Bsdf::from_material(
-        sh.material, media[static_cast<size_t>(scene_.outside_medium())].eta_at(hit.p));
+        sh.material, media[static_cast<size_t>(scene_.outside_medium(hit.shape))].eta_at(hit.p));
     const Frame frame(hit.ng);
     const Vec3 wo = frame.to_local(-ray.d);
     const bool wo_outside = front;
     if (photons && bsdf.is_diffuse()) photons->gather(bsdf, hit, frame, wo, beta, t, acc, stats);
     // Next-event estimation, except where a photon owns the path (light -> glossy -> diffuse).
     if (!bsdf.is_delta() && !(!bsdf.is_diffuse() && owned(last)))
-      estimate_direct_surface(bsdf, hit, frame, wo, wo_outside, beta, t, rng, acc, stats);
+      estimate_direct_surface(bsdf, hit, frame, wo, wo_outside, m, beta, t, rng, acc, stats);
     if (bsdf.is_diffuse()) {
       last = Last::Diffuse;
       since = 0;
@@ -276,7 +280,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     beta *= bs.weight;
     if (beta.is_black()) break;
     const bool wi_outside = bs.wi.z > 0;
-    if (bs.transmitted) m = wi_outside ? scene_.outside_medium() : scene_.inside_medium(hit.shape);
+    if (bs.transmitted)
+      m = wi_outside ? scene_.outside_medium(hit.shape) : scene_.inside_medium(hit.shape);
     specular = bs.delta;
     prev_pdf = bs.pdf;
     prev_p = hit.p;

@@ -79,10 +79,11 @@ class VolPathIntegrator {
                         PathStats& stats) const;
   void deposit(double t_ps, double sigma_ps, const RGB& value, PixelAccumulator& acc,
                PathStats& stats) const;
-  /// Next-event estimation at a surface vertex with a non-delta BSDF (local frame z = ng).
+  /// Next-event estimation at a surface vertex with a non-delta BSDF (local frame z = ng); m_wo
+  /// is the medium on the side of wo (the path's).
   void estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame,
-                               const Vec3& wo, bool wo_outside, const RGB& beta, double t, Rng& rng,
-                               PixelAccumulator& acc, PathStats& stats) const;
+                               const Vec3& wo, bool wo_outside, int m_wo, const RGB& beta, double t,
+                               Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
 
   const Scene& scene_;
   MediumTracker tracker_;

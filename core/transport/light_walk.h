@@ -50,8 +50,8 @@ struct LightVertex {
 inline int medium_at_origin(const Scene& scene, const Ray& ray) {
   SurfaceHit hit;
   if (!scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit))
-    return scene.outside_medium();
-  return dot(ray.d, hit.ng) > 0 ? scene.inside_medium(hit.shape) : scene.outside_medium();
+    return scene.global_medium();
+  return dot(ray.d, hit.ng) > 0 ? scene.inside_medium(hit.shape) : scene.outside_medium(hit.shape);
 }
 
 /// Traces one light sub-path from a light picked by power. `visit(const LightVertex&)` returns
@@ -171,7 +171,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
     if (sh.material.type == MaterialDesc::Type::None) {
       ++stats.null_crossings;
       if (++null_crossings > kMaxNullCrossings) return;
-      m = front ? scene.inside_medium(hit.shape) : scene.outside_medium();
+      m = front ? scene.inside_medium(hit.shape) : scene.outside_medium(hit.shape);
       ray.o = hit.p + ray.d * eps;
       continue;
     }
@@ -182,7 +182,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
     }
     ++depth;
     const Bsdf bsdf = Bsdf::from_material(
-        sh.material, media[static_cast<size_t>(scene.outside_medium())].eta_at(hit.p));
+        sh.material, media[static_cast<size_t>(scene.outside_medium(hit.shape))].eta_at(hit.p));
     const Frame frame(hit.ng);
     v = LightVertex{};
     v.kind = LightVertex::Kind::Surface;
@@ -205,7 +205,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
     beta *= bs.weight;
     if (beta.is_black()) return;
     const bool out = bs.wi.z > 0;
-    if (bs.transmitted) m = out ? scene.outside_medium() : scene.inside_medium(hit.shape);
+    if (bs.transmitted) m = out ? scene.outside_medium(hit.shape) : scene.inside_medium(hit.shape);
     ray = {hit.p + hit.ng * (out ? eps : -eps), normalize(frame.to_world(bs.wi))};
   }
 }

@@ -118,7 +118,7 @@ bool MediumTracker::connect(const Vec3& x, int m, const Vec3& w, double dist, do
         MaterialDesc::Type::None)
       return false;
     ++stats.null_crossings;
-    m = dot(w, hit.ng) < 0 ? scene_.inside_medium(hit.shape) : scene_.outside_medium();
+    m = scene_.medium_beyond(hit.shape, w, hit.ng);
     ray.o = hit.p + w * eps;
     remaining -= s + eps;
   }
