@@ -19,11 +19,13 @@ namespace femto::diffusion {
 namespace {
 constexpr uint64_t kBatch = 4096;  // photons per batch: the unit of work and of ordered reduction
 
-void trace_photon(const PhotonTransport& transport, double t_end, Rng rng, PhotonTally& tally) {
+void trace_photon(const PhotonTransport& transport, double t_end, Rng rng, PhotonTally& tally,
+                  TallySums& sums) {
   Photon p;
   const double u1 = rng.uniform(), u2 = rng.uniform();
   p.d = sample_uniform_sphere(u1, u2);
-  while (p.alive && p.t < t_end) tally.add(transport.advance(p, rng));
+  while (p.alive && p.t < t_end) tally.add(transport.advance(p, rng), sums);
+  tally.end_photon(sums);
 }
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -76,10 +78,9 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
         TallySums& sums = partial[k];
         sums.reset(layout.size());
         const uint64_t p0 = (first + k) * kBatch, p1 = std::min(N, p0 + kBatch);
-        for (uint64_t i = p0; i < p1; ++i) {
-          trace_photon(transport, grid.time.t_end_ps(), Rng::for_sample(setup.seed, i, 0), tally);
-          tally.end_photon(sums);
-        }
+        for (uint64_t i = p0; i < p1; ++i)
+          trace_photon(transport, grid.time.t_end_ps(), Rng::for_sample(setup.seed, i, 0), tally,
+                       sums);
         progress.add(p1 - p0);
       });
     });

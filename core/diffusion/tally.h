@@ -4,7 +4,9 @@
 // energy, and per bin the time integrals of energy, r^2 and r^4. Nothing is sampled: the
 // estimators are unbiased and their only noise is that of the paths themselves.
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/diffusion/transport.h"
@@ -49,26 +51,39 @@ struct TallySums {
   void add(const TallySums& other);
 };
 
-/// Accumulates one photon at a time (sparse: only touched entries are flushed).
+/// Accumulates one photon at a time. A photon's segments must come in time order (as a walk
+/// makes them): each bin is then visited in one stretch, and its entries are final (added to
+/// the sums with their squares) when the photon moves on to the next bin.
 class PhotonTally {
  public:
   explicit PhotonTally(const Grid& grid);
   const TallyLayout& layout() const { return layout_; }
-  /// Adds the part of the segment inside the time window.
-  void add(const Segment& s);
-  /// Adds this photon's integrals and their squares to `into` and starts the next photon.
+  /// Adds the part of the segment inside the time window; bins the photon has left go to `into`
+  /// (the same for all of a photon's segments and its end_photon).
+  void add(const Segment& s, TallySums& into);
+  /// Adds the rest of this photon's integrals and their squares to `into`; the next photon starts.
   void end_photon(TallySums& into);
 
  private:
-  void put(size_t i, double x);
-  void bin_piece(const Segment& s, int bin, double tau1, double tau2);
+  void enter_bin(int bin, TallySums& into);
+  void finish_bin(TallySums& into);
+  void put_cell(int shell, double x) {
+    shell_[static_cast<size_t>(shell)] += x;
+    i_lo_ = std::min(i_lo_, shell);
+    i_hi_ = std::max(i_hi_, shell);
+  }
+  double bin_end(int bin, double hi) const;  ///< end of bin's part of [.., hi], absolute ps
+  void bin_moments(const Segment& s, double tau1, double tau2);
 
   Grid grid_;
   TallyLayout layout_;
-  std::vector<double> value_;
-  std::vector<uint64_t> stamp_;  // photon that last touched an entry
-  std::vector<size_t> touched_;
-  uint64_t photon_ = 1, segments_ = 0;
+  // The current bin: its per-bin integrals and its shells (the radius is continuous, so the
+  // shells touched in one bin are the range [i_lo_, i_hi_]).
+  int bin_ = -1;
+  double q_[kQuantities] = {0, 0, 0, 0, 0};
+  std::vector<double> shell_;
+  int i_lo_ = std::numeric_limits<int>::max(), i_hi_ = -1;
+  uint64_t segments_ = 0;
 };
 
 /// J[n] = integral over s in [0, h] of exp(-k s) s^n, n = 0..4, for k >= 0 and h >= 0: a power
