@@ -25,8 +25,9 @@ class Comm {
   virtual void gather(const std::vector<char>& mine, const Fold& fold) const { fold(0, mine); }
   /// Collective: rank 0's values become the elementwise sums over all ranks (exact: integers).
   virtual void sum_to_root(std::vector<uint64_t>& values) const { (void)values; }
-  /// Collective: rank 0's flag, on every rank (decisions such as stopping early).
-  virtual bool root_flag(bool flag) const { return flag; }
+  /// Collective: rank 0's value, on every rank (sizes, decisions such as stopping early).
+  virtual uint64_t from_root(uint64_t value) const { return value; }
+  bool root_flag(bool flag) const { return from_root(flag ? 1 : 0) != 0; }
 
  protected:
   int rank_ = 0, size_ = 1;

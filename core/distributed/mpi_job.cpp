@@ -60,11 +60,9 @@ class MpiComm final : public Comm {
     }
   }
 
-  bool root_flag(bool flag) const override {
-    if (size_ <= 1) return flag;
-    int v = flag ? 1 : 0;
-    MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
-    return v != 0;
+  uint64_t from_root(uint64_t value) const override {
+    if (size_ > 1) MPI_Bcast(&value, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+    return value;
   }
 };
 
