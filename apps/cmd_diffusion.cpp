@@ -75,6 +75,9 @@ const char* kDiffusionHelp =
     "  --quiet            no progress or summary on stderr\n"
     "  --help             this help\n"
     "\n"
+    "mpirun -np N femto diffusion ...: N ranks share the photons; rank 0 writes outputs\n"
+    "bit-identical to one process's (docs/mpi.md).\n"
+    "\n"
     "Outputs: fluence.csv, moments.csv, models.csv, fluence_models.csv, summary.json,\n"
     "fluence.png and distance.png (see docs/diffusion.md).\n";
 

@@ -107,6 +107,9 @@ const char* kRenderHelp =
     "done is written (render.json: \"complete\": false), exit code 130 or 143; a second\n"
     "signal aborts at once and leaves the output folder as it was.\n"
     "\n"
+    "mpirun -np N femto render ...: N ranks share the work; rank 0 writes outputs bit-identical\n"
+    "to one process's (no --checkpoint/--resume; a signal aborts the job; docs/mpi.md).\n"
+    "\n"
     "Outputs (see docs/outputs.md): steady.exr, frames/*.exr, peak_time.exr, transient.npy\n"
     "(float32, shape (H, W, T, 3)), before_window.exr, after_window.exr, steady.png,\n"
     "frames.png and render.json (settings, time axis in ps and OPL mm, timings, counters).\n";

@@ -22,6 +22,10 @@ void print_usage() {
   std::printf("\n  --version    print the version\n  --help       this help\n\n");
   std::printf("Units: millimetres and picoseconds. Exit codes: 0 ok, 1 failure, 2 bad input.\n");
   std::printf("Documentation: README.md and docs/ (scene-format.md, outputs.md).\n");
+  std::printf(
+      "Across processes or machines: mpirun -np N femto render|tissue|diffusion ... "
+      "(docs/mpi.md)%s.\n",
+      femto::distributed::mpi_built() ? "" : "; this build has no MPI");
 }
 }  // namespace
 
