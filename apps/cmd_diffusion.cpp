@@ -17,6 +17,7 @@
 #include "core/diffusion/models.h"
 #include "core/diffusion/report.h"
 #include "core/error.h"
+#include "core/distributed/comm.h"
 #include "core/progress.h"
 #include "core/scene_loader.h"
 #include "media/grid_medium.h"
@@ -73,6 +74,9 @@ const char* kDiffusionHelp =
     "  --out DIR          output folder, created if missing (default ./femto-diffusion)\n"
     "  --quiet            no progress or summary on stderr\n"
     "  --help             this help\n"
+    "\n"
+    "mpirun -np N femto diffusion ...: N ranks share the photons; rank 0 writes outputs\n"
+    "bit-identical to one process's (docs/mpi.md).\n"
     "\n"
     "Outputs: fluence.csv, moments.csv, models.csv, fluence_models.csv, summary.json,\n"
     "fluence.png and distance.png (see docs/diffusion.md).\n";
@@ -259,7 +263,17 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
   setup.grid.time = TimeAxis{t_start, (*t_end - t_start) / t_bins, t_bins};
   setup.grid.shells = r_bins;
   setup.grid.dr = *r_max / r_bins;
+  // Under mpirun (docs/mpi.md) every rank checks the same input and traces its share; rank 0
+  // reports and writes.
+  const distributed::Comm& comm = distributed::world();
+  if (!comm.root()) quiet = true;
+  if (!comm.single()) setup.comm = &comm;
   setup.quiet = quiet;
+  if (!comm.root()) {
+    if (transport) diffusion::simulate(setup, *transport);
+    else diffusion::simulate(setup);
+    return 0;
+  }
 
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
@@ -292,6 +306,7 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
              {"command", command_line},
              {"date_utc", cli::utc_now()},
              {"source", source},
+             {"mpi_ranks", comm.size()},
              {"photons_requested", setup.photons},
              {"photons_traced", result.photons},
              {"stopped_early", !result.stopped_early ? nlohmann::json(nullptr)

@@ -16,6 +16,7 @@
 #include "apps/commands.h"
 #include "apps/stop_signals.h"
 #include "core/checkpoint.h"
+#include "core/distributed/comm.h"
 #include "core/io/sha256.h"
 #include "core/memory_usage.h"
 #include "core/output_folder.h"
@@ -105,6 +106,9 @@ const char* kRenderHelp =
     "Ctrl-C or SIGTERM: the current pass is finished and a complete result for the samples\n"
     "done is written (render.json: \"complete\": false), exit code 130 or 143; a second\n"
     "signal aborts at once and leaves the output folder as it was.\n"
+    "\n"
+    "mpirun -np N femto render ...: N ranks share the work; rank 0 writes outputs bit-identical\n"
+    "to one process's (no --checkpoint/--resume; a signal aborts the job; docs/mpi.md).\n"
     "\n"
     "Outputs (see docs/outputs.md): steady.exr, frames/*.exr, peak_time.exr, transient.npy\n"
     "(float32, shape (H, W, T, 3)), before_window.exr, after_window.exr, steady.png,\n"
@@ -252,6 +256,15 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       args.fail("only one scene file may be given", a);
     }
   }
+
+  // Under mpirun (docs/mpi.md) every rank loads and checks the same input; rank 0 reports and
+  // writes. Stopping early and checkpoints are for a single process.
+  const distributed::Comm& comm = distributed::world();
+  if (!comm.single() && (checkpoint || !resume_dir.empty()))
+    throw InputError(std::string("femto render: ") + (checkpoint ? "--checkpoint" : "--resume") +
+                     ": not available under mpirun (" + std::to_string(comm.size()) +
+                     " ranks); run a single process to checkpoint or resume");
+  if (!comm.root()) quiet = true;
 
   // Load and validate everything before anything is written.
   std::string scene_text;
@@ -414,6 +427,13 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                      "), more than --max-memory " + cli::format_bytes(max_memory) +
                      ": lower the resolution, the number of bins or the volumes' size, or raise --max-memory");
 
+  if (!comm.single()) {  // each rank renders its share; rank 0 receives the rest and writes
+    opt.comm = &comm;
+    if (!comm.root()) {
+      render(scene, opt);
+      return 0;
+    }
+  }
   // Outputs go to a staging folder beside --out, swapped in at the end (core/output_folder.h).
   OutputFolder folder(out.dir, checkpoint);
   stop_signals::on_abort([&folder] { folder.discard(); });
@@ -423,7 +443,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   OutputOptions staged = out;
   staged.dir = folder.staging();
 
-  opt.stop = &stop_signals::requested();
+  if (comm.single()) opt.stop = &stop_signals::requested();  // across ranks a signal aborts
   if (resumed) opt.resume = &resumed->state;
   const auto start_time = std::chrono::steady_clock::now();
   auto last_checkpoint = start_time;
@@ -442,7 +462,8 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       last_checkpoint = std::chrono::steady_clock::now();
     }
   };
-  stop_signals::defer(quiet ? "" : "finishing the current pass, then writing the results (again to abort)");
+  if (comm.single())
+    stop_signals::defer(quiet ? "" : "finishing the current pass, then writing the results (again to abort)");
   RenderResult result = render(scene, opt);
   const PathStats& st = result.stats;
   const uint64_t film_nonfinite = result.film.zero_nonfinite();  // outputs stay finite
@@ -459,6 +480,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"seed", opt.seed},
                       {"threads", result.threads},
                       {"threads_requested", threads},
+                      {"mpi_ranks", comm.size()},
                       {"max_depth", opt.max_depth},
                       {"max_depth_source", depth_source},
                       {"integrator", integrator_json(kind, integrator_why, opt, result)},

@@ -7,6 +7,7 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/tissue_run.h"
+#include "core/distributed/comm.h"
 #include "core/error.h"
 #include "core/output_folder.h"
 #include "core/progress.h"
@@ -38,6 +39,9 @@ const char* kTissueHelp =
     "                     75% of physical memory\n"
     "  --quiet            no progress or summary on stderr\n"
     "  --help             this help\n"
+    "\n"
+    "mpirun -np N femto tissue ...: N ranks share the photons; rank 0 writes outputs\n"
+    "bit-identical to one process's (docs/mpi.md).\n"
     "\n"
     "Outputs: fluence.npy (X,Y,Z,T float32, 1/mm^2 per gate per unit launched energy),\n"
     "fluence_rate.npy (1/(mm^2 ps)), fluence.nii, fluence_stderr.npy (on request), tpsf.npy and\n"
@@ -91,7 +95,12 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
   if (opt.photons) s.photons = *opt.photons;
   if (opt.seed) s.seed = *opt.seed;
   s.threads = opt.threads;
-  s.quiet = opt.quiet;
+  // Under mpirun (docs/mpi.md) every rank checks the same input and traces its chunks; rank 0
+  // reports and writes.
+  const distributed::Comm& comm = distributed::world();
+  const bool quiet = opt.quiet || !comm.root();
+  s.quiet = quiet;
+  if (!comm.single()) s.comm = &comm;
   const int threads = tissue::threads_for(s);
   const uint64_t max_memory =
       opt.max_memory ? opt.max_memory : cli::physical_memory_bytes() / 4 * 3;
@@ -118,7 +127,7 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
                          "', which is not part of a femto run; give an empty or new folder");
     }
   }
-  if (!opt.quiet)
+  if (!quiet)
     std::fprintf(
         stderr,
         "femto tissue: %s: %d x %d x %d voxels of %g mm, %zu labels, %s boundary; %llu photons, "
@@ -129,6 +138,10 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
         static_cast<unsigned long long>(s.photons), s.time.bins, s.time.bin_width_ps,
         cli::format_bytes(fluence_bytes).c_str(), threads,
         cli::format_bytes(s.volume.memory_bytes()).c_str(), cli::format_bytes(need).c_str());
+  if (!comm.root()) {
+    tissue::simulate(s);
+    return 0;
+  }
   OutputFolder folder(opt.out, false);
   const tissue::Result r = tissue::simulate(s);
   nlohmann::json record = {
@@ -140,10 +153,11 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
       {"scene", {{"source", path}, {"json", nlohmann::json::parse(text, nullptr, false, true)}}},
       {"seed", s.seed},
       {"threads", r.threads},
+      {"mpi_ranks", comm.size()},
       {"memory_bytes_estimate", need}};
   const std::vector<std::string> files = tissue::write_outputs(folder.staging(), s, r, record);
   folder.commit();
-  if (!opt.quiet) {
+  if (!quiet) {
     const double N = static_cast<double>(r.photons);
     std::fprintf(stderr,
                  "femto tissue: %llu photons in %s (%d threads, %.1f photons/ms); absorbed %.6f, "

@@ -6,6 +6,9 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "apps/stop_signals.h"
+#include "core/distributed/comm.h"
+#include "core/distributed/job.h"
 #include "core/error.h"
 #include "femto_version.h"
 
@@ -19,36 +22,61 @@ void print_usage() {
   std::printf("\n  --version    print the version\n  --help       this help\n\n");
   std::printf("Units: millimetres and picoseconds. Exit codes: 0 ok, 1 failure, 2 bad input.\n");
   std::printf("Documentation: README.md and docs/ (scene-format.md, outputs.md).\n");
+  std::printf(
+      "Across processes or machines: mpirun -np N femto render|tissue|diffusion ... "
+      "(docs/mpi.md)%s.\n",
+      femto::distributed::mpi_built() ? "" : "; this build has no MPI");
+}
+}  // namespace
+
+namespace {
+// A command's exit code; under MPI a failing rank ends the whole job with it (docs/mpi.md).
+int leave(int code) {
+  if (code != 0 && !femto::distributed::world().single()) femto::distributed::abort_job(code);
+  femto::distributed::finish();
+  return code;
+}
+// "femto: error: ..." with the rank under MPI.
+void report(const char* kind, const char* what) {
+  const std::string rank = femto::distributed::rank_label();
+  std::fprintf(stderr, "femto: %s%s%s: %s\n", kind, rank.empty() ? "" : " on ", rank.c_str(), what);
 }
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Under mpirun: signals go to femto's waiting thread (blocked before MPI starts its threads),
+  // then the process joins the job.
+  if (femto::distributed::launched_by_mpi()) femto::stop_signals::start();
+  femto::distributed::start(argc, argv);
   std::vector<std::string> args(argv + 1, argv + argc);
   std::string command_line = "femto";
   for (const auto& a : args) command_line += " " + a;
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-    print_usage();
-    return args.empty() ? 2 : 0;
+    if (femto::distributed::world().root()) print_usage();
+    return leave(args.empty() ? 2 : 0);
   }
   if (args[0] == "--version" || args[0] == "-V") {
-    std::printf("femto %s (%s)\n", FEMTO_VERSION, FEMTO_GIT_DESCRIBE);
-    return 0;
+    std::printf("femto %s (%s%s)\n", FEMTO_VERSION, FEMTO_GIT_DESCRIBE,
+                femto::distributed::mpi_built() ? ", MPI" : "");
+    return leave(0);
   }
   const std::string name = args[0];
   args.erase(args.begin());
   for (const auto& c : femto::commands()) {
     if (name != c.name) continue;
+    int code = 0;
     try {
-      return c.run(args, command_line);
+      code = c.run(args, command_line);
     } catch (const femto::InputError& e) {
-      std::fprintf(stderr, "femto: error: %s\n", e.what());
-      return 2;
+      report("error", e.what());
+      code = 2;
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "femto: failure: %s\n", e.what());
-      return 1;
+      report("failure", e.what());
+      code = 1;
     }
+    return leave(code);
   }
   std::fprintf(stderr, "femto: unknown command '%s' (try femto --help)\n",
                femto::clip(name).c_str());
-  return 2;
+  return leave(2);
 }

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/distributed/render_gather.h"
 #include "core/integrators/light_tracer.h"
 #include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
@@ -126,7 +127,10 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
   const int hardware = tbb::info::default_concurrency();
   const int threads = opt.threads > 0 ? std::min(opt.threads, hardware) : hardware;
   const uint64_t per_pixel_spp = static_cast<uint64_t>(opt.spp);
-  Progress progress(static_cast<uint64_t>(pixels) * per_pixel_spp, "render", opt.quiet);
+  // Across ranks, band b of tile rows is rendered by rank b % ranks; progress shows this rank's.
+  const distributed::Comm& comm = opt.comm ? *opt.comm : distributed::alone();
+  Progress progress(distributed::own_band_pixels(comm, W, H, kTile) * per_pixel_spp, "render",
+                    opt.quiet);
   auto pixels_in_rows = [&](int64_t tile_rows) {
     return static_cast<uint64_t>(std::min<int64_t>(H, tile_rows * kTile)) *
            static_cast<uint64_t>(W);
@@ -148,6 +152,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
             PixelAccumulator& acc = accumulators.local();
             PathStats& st = stats.local();
             for (int tile = r.begin(); tile != r.end(); ++tile) {
+              if (!comm.owns(tile / tiles_x)) continue;
               const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
               const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
               for (int y = y0; y < y1; ++y) {
@@ -182,6 +187,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
     }
   });
   progress.finish();
+  distributed::gather_bands(comm, state, W, H, kTile);
 
   RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};
   result.complete = state.units_done == total;

@@ -13,6 +13,9 @@
 
 namespace femto {
 
+namespace distributed {
+class Comm;
+}
 struct RenderState;
 
 struct RenderOptions {
@@ -42,6 +45,10 @@ struct RenderOptions {
   /// `pass_seconds`. Photon passes are always one photon pass.
   int64_t units_per_pass = 0;
   double pass_seconds = 1.0;
+  /// The processes sharing this render (core/distributed/comm.h; nullptr: this one alone). Each
+  /// renders its share; rank 0 gets the result, bit-identical to a single process's. Not with
+  /// stop, after_pass or resume.
+  const distributed::Comm* comm = nullptr;
 };
 
 /// Everything a render continues from between passes (and in a checkpoint).

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/distributed/bytes.h"
+#include "core/distributed/render_gather.h"
 #include "core/integrators/light_tracer.h"
 #include "core/progress.h"
 #include "core/render.h"
@@ -51,7 +53,13 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
   std::vector<const Splat*> sorted;
 
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
-  Progress progress(static_cast<uint64_t>(total), "light paths", opt.quiet);
+  // Across ranks, chunk c is traced by rank c % ranks; after each batch, rank 0 receives the
+  // other ranks' splats by chunk and bins the whole batch in path order as a single process does.
+  const distributed::Comm& comm = opt.comm ? *opt.comm : distributed::alone();
+  uint64_t own_paths = 0;
+  for (int64_t c = 0; c < chunks; ++c)
+    if (comm.owns(c)) own_paths += static_cast<uint64_t>(std::min(total, (c + 1) * kChunk) - c * kChunk);
+  Progress progress(own_paths, "light paths", opt.quiet);
   progress.add(static_cast<uint64_t>(std::min(total, state.units_done * kChunksPerBatch * kChunk)));
   tbb::enumerable_thread_specific<PathStats> stats;
   tbb::task_arena arena(threads);
@@ -64,6 +72,7 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
           tbb::blocked_range<int64_t>(c0, c1, 1), [&](const tbb::blocked_range<int64_t>& r) {
             PathStats& st = stats.local();
             for (int64_t c = r.begin(); c != r.end(); ++c) {
+              if (!comm.owns(c)) continue;
               std::vector<Splat>& out = per_chunk[static_cast<size_t>(c - c0)];
               out.clear();
               const int64_t end = std::min(total, (c + 1) * kChunk);
@@ -74,6 +83,24 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
               progress.add(static_cast<uint64_t>(end - c * kChunk));
             }
           });
+      if (!comm.single()) {
+        distributed::ByteWriter mine;
+        if (!comm.root())
+          for (int64_t c = c0; c < c1; ++c)
+            if (comm.owns(c)) mine.put_vector(per_chunk[static_cast<size_t>(c - c0)]);
+        comm.gather(mine.bytes(), [&](int rank, const std::vector<char>& bytes) {
+          if (rank == 0) return;
+          distributed::ByteReader in(bytes);
+          for (int64_t c = c0; c < c1; ++c)
+            if (c % comm.size() == rank)
+              per_chunk[static_cast<size_t>(c - c0)] = in.get_vector<Splat>();
+        });
+        if (!comm.root()) {  // rank 0 bins the batch
+          ++state.units_done;
+          passes::end_pass(state, stats, pass_start, opt, batches);
+          continue;
+        }
+      }
       // Bin the batch: a stable counting sort by pixel keeps path order within each pixel, so
       // every pixel sums its splats in the same order whatever the thread count.
       std::fill(offsets.begin(), offsets.end(), 0u);
@@ -112,6 +139,7 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
     }
   });
   progress.finish();
+  distributed::sum_stats(comm, state.stats);
   per_chunk.clear();
   per_chunk.shrink_to_fit();
   sorted = {};

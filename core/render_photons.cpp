@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/distributed/render_gather.h"
 #include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
 #include "core/integrators/ppm_schedule.h"
@@ -59,6 +60,9 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
 
+  // Across ranks, every rank traces each pass's photons and beams (the same for all: they
+  // depend on the seed and pass only) and gathers them into its bands of tile rows.
+  const distributed::Comm& comm = opt.comm ? *opt.comm : distributed::alone();
   Progress progress(static_cast<uint64_t>(opt.spp), use_beams ? "beam passes" : "photon passes",
                     opt.quiet, "passes");
   progress.add(static_cast<uint64_t>(state.units_done));
@@ -112,6 +116,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
             PixelAccumulator& acc = accumulators.local();
             PathStats& st = stats.local();
             for (int tile = r.begin(); tile != r.end(); ++tile) {
+              if (!comm.owns(tile / tiles_x)) continue;
               const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
               const int x1 = std::min(x0 + kTile, W), y1 = std::min(y0 + kTile, H);
               for (int y = y0; y < y1; ++y)
@@ -137,11 +142,12 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       beam_schedule.advance();
       progress.add(1);
       ++state.units_done;
-      state.stats += photon_stats;
+      if (comm.root()) state.stats += photon_stats;  // traced by every rank, counted once
       if (passes::end_pass(state, stats, pass_start, opt, opt.spp)) break;
     }
   });
   progress.finish();
+  distributed::gather_bands(comm, state, W, H, kTile);
   grid = PhotonGrid();
   bvh = BeamBvh();
   RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};

@@ -11,6 +11,8 @@
 #include <cstdio>
 
 #include "core/diffusion/models.h"
+#include "core/distributed/bytes.h"
+#include "core/distributed/comm.h"
 #include "core/progress.h"
 #include "core/sampling.h"
 
@@ -56,46 +58,93 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
   const uint64_t batches = (N + kBatch - 1) / kBatch;
   // Batches in flight per round: two per thread, within 1 GiB of partial sums.
   const size_t slot_bytes = 2 * sizeof(double) * layout.size();
-  const size_t slots = std::max<size_t>(
-      1, std::min<size_t>(2 * static_cast<size_t>(threads), (size_t{1} << 30) / slot_bytes));
+  const distributed::Comm& comm = setup.comm ? *setup.comm : distributed::alone();
+  // Rank 0's round size for every rank: rank r does units [first + r slots, first + (r+1) slots).
+  const size_t slots = static_cast<size_t>(comm.from_root(std::max<size_t>(
+      1, std::min<size_t>(2 * static_cast<size_t>(threads), (size_t{1} << 30) / slot_bytes))));
+  const uint64_t round = static_cast<uint64_t>(slots) * static_cast<uint64_t>(comm.size());
+  auto own_units = [&](uint64_t first, uint64_t& u0, uint64_t& u1) {
+    u0 = std::min(batches, first + static_cast<uint64_t>(comm.rank()) * slots);
+    u1 = std::min(batches, u0 + slots);
+  };
+  uint64_t own_photons = 0;
+  for (uint64_t first = 0; first < batches; first += round) {
+    uint64_t u0, u1;
+    own_units(first, u0, u1);
+    if (u1 > u0) own_photons += std::min(N, u1 * kBatch) - u0 * kBatch;
+  }
 
   TallySums total;
   total.reset(layout.size());
   // Statistical batches: contiguous ranges of the work units, fixed by the photon count.
-  const uint64_t stat_batches = std::clamp<uint64_t>(static_cast<uint64_t>(std::max(setup.batches, 1)), 1, batches);
+  const uint64_t stat_batches =
+      std::clamp<uint64_t>(static_cast<uint64_t>(std::max(setup.batches, 1)), 1, batches);
   std::vector<std::vector<double>> batch_sum(stat_batches, std::vector<double>(layout.size(), 0.0));
   std::vector<uint64_t> batch_photons(stat_batches, 0);
   bool stopped_early = false;
   std::vector<TallySums> partial(slots);
   tbb::enumerable_thread_specific<PhotonTally> tallies([&] { return PhotonTally(grid); });
-  Progress progress(N, "diffusion", setup.quiet, "photons");
+  Progress progress(own_photons, "diffusion", setup.quiet, "photons");
   tbb::task_arena arena(threads);
-  for (uint64_t first = 0; first < batches; first += slots) {
-    const size_t count = static_cast<size_t>(std::min<uint64_t>(slots, batches - first));
+  for (uint64_t first = 0; first < batches; first += round) {
+    uint64_t u0, u1;
+    own_units(first, u0, u1);
+    const size_t count = static_cast<size_t>(u1 - u0);
     arena.execute([&] {
       tbb::parallel_for(size_t{0}, count, [&](size_t k) {
         PhotonTally& tally = tallies.local();
         TallySums& sums = partial[k];
         sums.reset(layout.size());
-        const uint64_t p0 = (first + k) * kBatch, p1 = std::min(N, p0 + kBatch);
+        const uint64_t p0 = (u0 + k) * kBatch, p1 = std::min(N, p0 + kBatch);
         for (uint64_t i = p0; i < p1; ++i)
           trace_photon(transport, grid.time.t_end_ps(), Rng::for_sample(setup.seed, i, 0), tally,
                        sums);
         progress.add(p1 - p0);
       });
     });
-    for (size_t k = 0; k < count; ++k) {  // batch order: thread-independent
-      total.add(partial[k]);
-      const uint64_t b = (first + k) * stat_batches / batches;
+    // Unit order: thread-independent; across ranks, rank r's units follow rank r - 1's.
+    auto fold = [&](uint64_t unit, const TallySums& part) {
+      total.add(part);
+      const uint64_t b = unit * stat_batches / batches;
       std::vector<double>& bs = batch_sum[b];
-      for (size_t i = 0; i < bs.size(); ++i) bs[i] += partial[k].sum[i];
-      batch_photons[b] += partial[k].photons;
+      for (size_t i = 0; i < bs.size(); ++i) bs[i] += part.sum[i];
+      batch_photons[b] += part.photons;
+    };
+    if (comm.single()) {
+      for (size_t k = 0; k < count; ++k) fold(u0 + k, partial[k]);
+    } else {
+      distributed::ByteWriter mine;
+      if (!comm.root())
+        for (size_t k = 0; k < count; ++k) {
+          mine.put_vector(partial[k].sum);
+          mine.put_vector(partial[k].sum2);
+          mine.put(partial[k].photons);
+          mine.put(partial[k].segments);
+        }
+      TallySums theirs;
+      comm.gather(mine.bytes(), [&](int rank, const std::vector<char>& bytes) {
+        if (rank == 0) {
+          for (size_t k = 0; k < count; ++k) fold(u0 + k, partial[k]);
+          return;
+        }
+        const uint64_t r0 = std::min(batches, first + static_cast<uint64_t>(rank) * slots);
+        const uint64_t r1 = std::min(batches, r0 + slots);
+        distributed::ByteReader in(bytes);
+        for (uint64_t unit = r0; unit < r1; ++unit) {
+          theirs.sum = in.get_vector<double>();
+          theirs.sum2 = in.get_vector<double>();
+          theirs.photons = in.get<uint64_t>();
+          theirs.segments = in.get<uint64_t>();
+          fold(unit, theirs);
+        }
+      });
     }
     const double elapsed = seconds_since(start);
-    if (first == 0 && !setup.quiet) print_estimate(elapsed, slots * kBatch, N);
-    const bool more = first + slots < batches;
-    if (more && ((setup.stop && setup.stop->load()) ||
-                 (setup.max_seconds > 0 && elapsed >= setup.max_seconds))) {
+    if (first == 0 && !setup.quiet) print_estimate(elapsed, round * kBatch, N);
+    const bool more = first + round < batches;
+    // Rank 0 decides whether to stop, for every rank.
+    if (more && comm.root_flag((setup.stop && setup.stop->load()) ||
+                               (setup.max_seconds > 0 && elapsed >= setup.max_seconds))) {
       stopped_early = true;
       break;
     }
@@ -144,9 +193,10 @@ DiffusionResult estimate(const DiffusionSetup& setup, const TallySums& total) {
     const double t0 = grid.time.bin_start_ps(j);
     estimate(layout.slot(Quantity::Energy, j), 1 / dt, r.energy[j], r.energy_err[j]);
     // Expected energy-time in the bin: exact for a homogeneous medium, else the MC estimate.
-    const double exact = setup.normalise_by_energy ? r.energy[j] * dt
-                                                   : survival_integral(setup.medium, t0, t0 + dt);
-    const double rel_den = setup.normalise_by_energy && r.energy[j] > 0 ? r.energy_err[j] / r.energy[j] : 0.0;
+    const double exact =
+        setup.normalise_by_energy ? r.energy[j] * dt : survival_integral(setup.medium, t0, t0 + dt);
+    const double rel_den =
+        setup.normalise_by_energy && r.energy[j] > 0 ? r.energy_err[j] / r.energy[j] : 0.0;
     auto ratio = [&](Quantity q, double& mean, double& err) {
       estimate(layout.slot(q, j), exact > 0 ? 1 / exact : 0.0, mean, err);
       if (rel_den > 0 && mean != 0) err = std::hypot(err, std::abs(mean) * rel_den);

@@ -12,6 +12,9 @@
 #include "core/diffusion/transport.h"
 #include "media/homogeneous.h"
 
+namespace femto::distributed {
+class Comm;
+}
 namespace femto::diffusion {
 
 struct DiffusionSetup {
@@ -33,6 +36,9 @@ struct DiffusionSetup {
   /// Independent batches (contiguous photon ranges) kept apart for confidence intervals of
   /// derived values such as t* (jackknife); 1: none.
   int batches = 10;
+  /// The processes sharing the run (core/distributed/comm.h; nullptr: this one alone): each round
+  /// of work units is cut into one contiguous range per rank, folded in unit order on rank 0.
+  const distributed::Comm* comm = nullptr;
 };
 
 /// Means and standard errors per unit emitted energy. Per-bin values are averages over the bin.

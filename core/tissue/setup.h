@@ -9,6 +9,9 @@
 #include "core/transport/tissue_volume.h"
 #include "core/transport/tissue_walk.h"
 
+namespace femto::distributed {
+class Comm;
+}
 namespace femto::tissue {
 
 /// A pulsed source. Beams (pencil, gaussian, disk) travel along `direction` from positions in the
@@ -67,6 +70,9 @@ struct Setup {
   int batches = 10;  ///< independent batches for standard errors and confidence intervals
   int threads = 0;   ///< 0: all cores
   bool quiet = true;
+  /// The processes sharing the run (core/distributed/comm.h; nullptr: this one alone): chunk c of
+  /// a batch is traced by rank c % ranks and rank 0 gets the result of a single process.
+  const distributed::Comm* comm = nullptr;
 };
 
 }  // namespace femto::tissue

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <memory>
 
+#include "core/distributed/bytes.h"
+#include "core/distributed/comm.h"
 #include "core/lights.h"
 #include "core/progress.h"
 #include "core/sampling.h"
@@ -67,6 +69,40 @@ struct ChunkSums {
     scatterings = segments = 0;
   }
 };
+
+// A chunk's sums as bytes, bit for bit (for rank 0, core/distributed/comm.h).
+void write_chunk(distributed::ByteWriter& w, const ChunkSums& c) {
+  w.put(c.balance);
+  w.put_vector(c.absorbed);
+  w.put_vector(c.tpsf);
+  w.put_vector(c.detected);
+  const DetectedPhotons& r = c.records;
+  w.put(r.labels);
+  w.put_vector(r.detector);
+  w.put_vector(r.scatterings);
+  w.put_vector(r.weight);
+  w.put_vector(r.time_ps);
+  w.put_vector(r.ppath);
+  w.put(r.dropped);
+  w.put(c.scatterings);
+  w.put(c.segments);
+}
+void read_chunk(distributed::ByteReader& in, ChunkSums& c) {
+  c.balance = in.get<Balance>();
+  c.absorbed = in.get_vector<double>();
+  c.tpsf = in.get_vector<double>();
+  c.detected = in.get_vector<double>();
+  DetectedPhotons& r = c.records;
+  r.labels = in.get<int>();
+  r.detector = in.get_vector<int32_t>();
+  r.scatterings = in.get_vector<int32_t>();
+  r.weight = in.get_vector<double>();
+  r.time_ps = in.get_vector<double>();
+  r.ppath = in.get_vector<double>();
+  r.dropped = in.get<uint64_t>();
+  c.scatterings = in.get<uint64_t>();
+  c.segments = in.get<uint64_t>();
+}
 
 // Integer sums of the volume tallies of one thread (fixed point: order-independent).
 struct ThreadSums {
@@ -554,16 +590,31 @@ Result simulate(const Setup& s) {
   const int batches =
       static_cast<int>(std::clamp<uint64_t>(static_cast<uint64_t>(s.batches), 1, s.photons));
   r.tpsf_batches.assign(static_cast<size_t>(batches) * tpsf_size, 0.0);
-  Progress progress(s.photons, "tissue", s.quiet, "photons");
+  // Across ranks, chunk c of every batch is traced by rank c % ranks: rank 0 folds the chunk sums
+  // in chunk order and adds the integer volume sums (exact in any order).
+  const distributed::Comm& comm = s.comm ? *s.comm : distributed::alone();
+  auto batch_range = [&](int b, uint64_t& p0, uint64_t& p1) {
+    p0 = s.photons * static_cast<uint64_t>(b) / static_cast<uint64_t>(batches);
+    p1 = s.photons * static_cast<uint64_t>(b + 1) / static_cast<uint64_t>(batches);
+  };
+  uint64_t own_photons = 0;
+  for (int b = 0; b < batches; ++b) {
+    uint64_t p0, p1;
+    batch_range(b, p0, p1);
+    for (uint64_t q0 = p0, c = 0; q0 < p1; q0 += kChunk, ++c)
+      if (comm.owns(static_cast<int64_t>(c))) own_photons += std::min(p1, q0 + kChunk) - q0;
+  }
+  Progress progress(own_photons, "tissue", s.quiet, "photons");
   tbb::task_arena arena(threads);
   for (int b = 0; b < batches; ++b) {
-    const uint64_t p0 = s.photons * static_cast<uint64_t>(b) / static_cast<uint64_t>(batches);
-    const uint64_t p1 = s.photons * static_cast<uint64_t>(b + 1) / static_cast<uint64_t>(batches);
+    uint64_t p0, p1;
+    batch_range(b, p0, p1);
     const size_t chunks = static_cast<size_t>((p1 - p0 + kChunk - 1) / kChunk);
     std::vector<ChunkSums> chunk(chunks);
     const auto trace_start = std::chrono::steady_clock::now();
     arena.execute([&] {
       tbb::parallel_for(size_t{0}, chunks, [&](size_t c) {
+        if (!comm.owns(static_cast<int64_t>(c))) return;
         ThreadSums& ts = thread_sums.local();
         ChunkSums& out = chunk[c];
         out.reset(labels, tpsf_size, ndet);
@@ -576,6 +627,43 @@ Result simulate(const Setup& s) {
     });
     r.trace_seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - trace_start).count();
+    if (!comm.single()) {
+      distributed::ByteWriter mine;
+      if (!comm.root())
+        for (size_t c = 0; c < chunks; ++c)
+          if (comm.owns(static_cast<int64_t>(c))) write_chunk(mine, chunk[c]);
+      comm.gather(mine.bytes(), [&](int rank, const std::vector<char>& bytes) {
+        if (rank == 0) return;
+        distributed::ByteReader in(bytes);
+        for (size_t c = static_cast<size_t>(rank); c < chunks;
+             c += static_cast<size_t>(comm.size()))
+          read_chunk(in, chunk[c]);
+      });
+      // Integer volume sums: without standard errors, other ranks keep adding theirs until the
+      // last batch. Rank 0 gets the sums of all threads of all ranks in one thread's sums; the
+      // others start again from 0.
+      if (s.fluence_stderr || b + 1 == batches) {
+        std::vector<uint64_t> sums(volume_size, 0);
+        for (size_t f = 0; f < 6; ++f) sums.resize(sums.size() + face_size[f], 0);
+        for (ThreadSums& ts : thread_sums) {
+          size_t at = 0;
+          for (size_t i = 0; i < volume_size; ++i) sums[at++] += ts.fluence[i];
+          for (size_t f = 0; f < 6; ++f)
+            for (size_t i = 0; i < face_size[f]; ++i) sums[at++] += ts.faces[f][i];
+          std::fill(ts.fluence.begin(), ts.fluence.end(), 0);
+          for (auto& f : ts.faces) std::fill(f.begin(), f.end(), 0);
+        }
+        comm.sum_to_root(sums);
+        if (comm.root()) {
+          ThreadSums& ts = thread_sums.local();
+          size_t at = 0;
+          for (size_t i = 0; i < volume_size; ++i) ts.fluence[i] = sums[at++];
+          for (size_t f = 0; f < 6; ++f)
+            for (size_t i = 0; i < face_size[f]; ++i) ts.faces[f][i] = sums[at++];
+        }
+      }
+      if (!comm.root()) continue;  // rank 0 folds the batch
+    }
     // Chunk order: the reduction does not depend on which thread traced what.
     std::vector<double> batch_tpsf(tpsf_size, 0.0);
     for (ChunkSums& c : chunk) {
