@@ -127,19 +127,25 @@ DiffusionRequest parse_diffusion_args(const std::vector<std::string>& argv_in,
       for (size_t i = 0; i < scene.media.size(); ++i)
         if (scene.media[i].name == medium_name) mi = static_cast<int>(i);
       if (mi < 0)
-        throw InputError(command + ": --medium: no medium named '" + clip(medium_name) +
-                         "' in " + clip(scene_path, 200));
+        throw InputError(command + ": --medium: no medium named '" + clip(medium_name) + "' in " +
+                         clip(scene_path, 200));
     }
     if (mi < 0)
-      throw InputError(command + ": --medium: " + clip(scene_path, 200) + " has no \"medium\" around everything; name one");
+      throw InputError(command + ": --medium: " + clip(scene_path, 200) +
+                       " has no \"medium\" around everything; name one");
     const MediumDesc& md = scene.media[static_cast<size_t>(mi)];
-    source = {{"kind", "scene medium"}, {"scene", scene_path}, {"medium", md.name},
-              {"position_mm", {at->x, at->y, at->z}}, {"shapes", "ignored: the medium fills space"}};
+    source = {{"kind", "scene medium"},
+              {"scene", scene_path},
+              {"medium", md.name},
+              {"position_mm", {at->x, at->y, at->z}},
+              {"shapes", "ignored: the medium fills space"}};
     if (md.type == MediumDesc::Type::Homogeneous) {
       setup.medium = md.medium;
     } else {
       if (absorption_given && setup.absorption == diffusion::Absorption::Weighted)
-        throw InputError(command + ": --absorption: 'weighted' needs a homogeneous medium; voxel media use analog (got 'weighted')");
+        throw InputError(command +
+                         ": --absorption: 'weighted' needs a homogeneous medium; voxel media use "
+                         "analog (got 'weighted')");
       const VolumeData data = load_volume(md.vdb, scene_path, medium_where(md.name));
       grid = std::make_unique<GridMedium>(data, md.vdb);
       transport = std::make_unique<diffusion::VoxelTransport>(*grid, md.medium.g, *at);
@@ -147,9 +153,12 @@ DiffusionRequest parse_diffusion_args(const std::vector<std::string>& argv_in,
       setup.normalise_by_energy = true;
       // The models and the default window use the medium at the source point.
       const double st = grid->sigma_t_at(*at), albedo = grid->albedo_at(*at);
-      setup.medium = HomogeneousMedium{(1 - albedo) * st, albedo * st, md.medium.g, grid->eta_at(*at)};
-      source["local_coefficients"] = {{"sigma_a", setup.medium.sigma_a}, {"sigma_s", setup.medium.sigma_s},
-                                      {"g", setup.medium.g}, {"eta", setup.medium.eta}};
+      setup.medium =
+          HomogeneousMedium{(1 - albedo) * st, albedo * st, md.medium.g, grid->eta_at(*at)};
+      source["local_coefficients"] = {{"sigma_a", setup.medium.sigma_a},
+                                      {"sigma_s", setup.medium.sigma_s},
+                                      {"g", setup.medium.g},
+                                      {"eta", setup.medium.eta}};
     }
   }
 
@@ -162,8 +171,7 @@ DiffusionRequest parse_diffusion_args(const std::vector<std::string>& argv_in,
   };
   if (!t_end) {
     if (!(sc.sigma_t > 0))  // no mean free time to scale the default window with
-      throw InputError(
-          command + ": --t-end: required in a clear medium (sigma_s = sigma_a = 0)");
+      throw InputError(command + ": --t-end: required in a clear medium (sigma_s = sigma_a = 0)");
     t_end = t_start + 40 * sc.mean_free_time;
   }
   if (!(*t_end > t_start)) fail("--t-end", "must be greater than --t-start", *t_end);
@@ -172,8 +180,9 @@ DiffusionRequest parse_diffusion_args(const std::vector<std::string>& argv_in,
     fail("--t-end", "time bins of (--t-end - --t-start) / --t-bins must be at least 1e-9 ps wide",
          *t_end);
   if (*r_max / r_bins < kMinShellMm)
-    fail("--r-max", "shells of --r-max / --r-bins (default r-max: (c / eta) t_end) must be at "
-                    "least 1e-9 mm thick",
+    fail("--r-max",
+         "shells of --r-max / --r-bins (default r-max: (c / eta) t_end) must be at "
+         "least 1e-9 mm thick",
          *r_max);
   if (static_cast<double>(t_bins) * r_bins > 2e6)
     fail("--r-bins", "shells x time bins must be at most 2e6 (lower --r-bins or --t-bins)", r_bins);

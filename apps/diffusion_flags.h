@@ -17,11 +17,11 @@ namespace femto {
 struct DiffusionRequest {
   bool help = false;  ///< --help was given (nothing else is set)
   diffusion::DiffusionSetup setup;
-  double threshold = 0.05;          ///< distance to the Gaussian that defines t*
-  std::vector<double> plot_times;   ///< ps; defaults to 1, 3, 10, 30 mean free times in the window
+  double threshold = 0.05;         ///< distance to the Gaussian that defines t*
+  std::vector<double> plot_times;  ///< ps; defaults to 1, 3, 10, 30 mean free times in the window
   std::string out_dir = "femto-diffusion";
   bool quiet = false;
-  nlohmann::json source;            ///< where the source sits (report's "source")
+  nlohmann::json source;  ///< where the source sits (report's "source")
   /// A voxel medium around the source (--scene with a VDB medium), else null: simulate(setup).
   std::unique_ptr<GridMedium> grid;
   std::unique_ptr<diffusion::PhotonTransport> transport;

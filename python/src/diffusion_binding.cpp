@@ -30,8 +30,8 @@ py::dict transition_of(const diffusion::Transition& t) {
 }
 
 py::dict diffusion_py(const py::kwargs& kwargs) {
-  const Flags flags = keyword_flags(
-      kwargs, "diffusion", {"out", "quiet", "q", "help", "h", "plot_times"});
+  const Flags flags =
+      keyword_flags(kwargs, "diffusion", {"out", "quiet", "q", "help", "h", "plot_times"});
   const std::string command = "femto.diffusion";
   DiffusionRequest request;
   try {
@@ -95,10 +95,10 @@ py::dict diffusion_py(const py::kwargs& kwargs) {
   d["t_star"]["noise_limited"] = conf.noise_limited;
   d["t_diffusion"] = transition_of(a.diffusion);
   d["t_paasschens"] = transition_of(a.paasschens);
-  d["medium"] = py::dict(py::arg("sigma_s") = setup.medium.sigma_s,
-                         py::arg("sigma_a") = setup.medium.sigma_a, py::arg("g") = setup.medium.g,
-                         py::arg("eta") = setup.medium.eta,
-                         py::arg("mean_free_time_ps") = sc.mean_free_time);
+  d["medium"] =
+      py::dict(py::arg("sigma_s") = setup.medium.sigma_s, py::arg("sigma_a") = setup.medium.sigma_a,
+               py::arg("g") = setup.medium.g, py::arg("eta") = setup.medium.eta,
+               py::arg("mean_free_time_ps") = sc.mean_free_time);
   d["source"] = py::module_::import("json").attr("loads")(request.source.dump());
   d["photons"] = r.photons;
   d["segments"] = r.segments;

@@ -52,8 +52,8 @@ std::string Flags::pythonic(std::string message) const {
     // Whole flags only: --photons must not rewrite the start of --photons-per-pass.
     for (size_t at = message.find(flag); at != std::string::npos; at = message.find(flag, at)) {
       const size_t end = at + flag.size();
-      if (end < message.size() && (std::isalnum(static_cast<unsigned char>(message[end])) ||
-                                   message[end] == '-')) {
+      if (end < message.size() &&
+          (std::isalnum(static_cast<unsigned char>(message[end])) || message[end] == '-')) {
         at = end;
         continue;
       }

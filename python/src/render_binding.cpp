@@ -59,9 +59,9 @@ py::dict time_axis_of(const RenderOutput& out) {
   return d;
 }
 
-const std::vector<std::string> kCommandOnly = {"out",  "frames", "no_previews", "max_memory",
-                                               "checkpoint", "checkpoint_every", "resume",
-                                               "help", "h"};
+const std::vector<std::string> kCommandOnly = {"out",        "frames",     "no_previews",
+                                               "max_memory", "checkpoint", "checkpoint_every",
+                                               "resume",     "help",       "h"};
 
 std::shared_ptr<RenderOutput> render_py(const py::object& scene, const py::object& spp,
                                         const py::object& threads, const py::object& seed,
@@ -84,8 +84,8 @@ std::shared_ptr<RenderOutput> render_py(const py::object& scene, const py::objec
     while (!args.done()) {
       const std::string a = args.next();
       if (!parse_render_flag(args, a, o))
-        throw py::type_error("render() got an unexpected keyword argument '" +
-                             flags.pythonic(a) + "'");
+        throw py::type_error("render() got an unexpected keyword argument '" + flags.pythonic(a) +
+                             "'");
     }
   } catch (const InputError& e) {
     raise_input_error(e, flags);
@@ -119,10 +119,9 @@ std::shared_ptr<RenderOutput> render_py(const py::object& scene, const py::objec
   const CameraDesc& cam = desc.camera;
   const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads_used = opt.threads > 0 ? std::min(opt.threads, hardware) : hardware;
-  const RenderMemory mem =
-      render_memory(cam.width, cam.height, desc.time.bins, opt, threads_used,
-                    desc.reconstruction.type == TemporalFilter::Kind::Kernel,
-                    desc.reconstruction.first_pass_spp, false);
+  const RenderMemory mem = render_memory(cam.width, cam.height, desc.time.bins, opt, threads_used,
+                                         desc.reconstruction.type == TemporalFilter::Kind::Kernel,
+                                         desc.reconstruction.first_pass_spp, false);
   if (mem.peak() > max_memory)
     throw py::value_error(command + ": the render needs " + cli::format_bytes(mem.peak()) +
                           ", more than 75% of this machine's memory (" +
@@ -163,8 +162,8 @@ std::shared_ptr<RenderOutput> render_py(const py::object& scene, const py::objec
 
   auto out = std::shared_ptr<RenderOutput>(new RenderOutput{std::move(*result), {}});
   const uint64_t nonfinite = out->result.film.zero_nonfinite();  // as the command's outputs
-  out->meta = render_info(*built, text.text, setup, o.max_depth.has_value(), out->result,
-                          nonfinite, nullptr);
+  out->meta = render_info(*built, text.text, setup, o.max_depth.has_value(), out->result, nonfinite,
+                          nullptr);
   std::string call = command + "(" + (text.path.empty() ? text.source : "'" + text.path + "'");
   for (const std::string& a : flags.argv) call += ", " + flags.pythonic(a);
   out->meta["command"] = call + ")";
@@ -235,9 +234,8 @@ void register_render(py::module_& m) {
       });
 
   m.def("render", &render_py, py::arg("scene") = py::none(), py::kw_only(),
-        py::arg("spp") = py::none(), py::arg("threads") = py::none(),
-        py::arg("seed") = py::none(), py::arg("progress") = py::none(),
-        py::arg("quiet") = true,
+        py::arg("spp") = py::none(), py::arg("threads") = py::none(), py::arg("seed") = py::none(),
+        py::arg("progress") = py::none(), py::arg("quiet") = true,
         R"doc(Renders a scene; returns a RenderResult.
 
 scene: None (the built-in default scene), a dict, JSON text or a path to a scene file.

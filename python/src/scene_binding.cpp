@@ -13,8 +13,9 @@ namespace {
 py::dict load_scene_py(const py::object& scene) {
   const SceneText text = scene_text_of(scene);
   if (tissue::is_tissue_scene(text.text))
-    throw py::value_error(text.source + ": a tissue scene (docs/tissue.md); femto.load_scene "
-                                        "checks camera scenes");
+    throw py::value_error(text.source +
+                          ": a tissue scene (docs/tissue.md); femto.load_scene "
+                          "checks camera scenes");
   SceneDesc desc;
   try {
     desc = load_scene_string(text.text, text.source, text.base_dir);
@@ -29,10 +30,10 @@ py::dict load_scene_py(const py::object& scene) {
   d["source"] = desc.source;
   d["width"] = desc.camera.width;
   d["height"] = desc.camera.height;
-  d["time_axis"] = py::dict(py::arg("t_start_ps") = desc.time.t_start_ps,
-                            py::arg("bin_width_ps") = desc.time.bin_width_ps,
-                            py::arg("bins") = desc.time.bins,
-                            py::arg("t_end_ps") = desc.time.t_end_ps());
+  d["time_axis"] =
+      py::dict(py::arg("t_start_ps") = desc.time.t_start_ps,
+               py::arg("bin_width_ps") = desc.time.bin_width_ps, py::arg("bins") = desc.time.bins,
+               py::arg("t_end_ps") = desc.time.t_end_ps());
   d["spp"] = desc.integrator.spp;
   d["seed"] = desc.integrator.seed;
   d["max_depth"] = desc.integrator.max_depth;
