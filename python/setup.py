@@ -39,4 +39,6 @@ class CMakeBuild(build_ext):
         shutil.copyfile(built[0], target)
 
 
-setup(ext_modules=[Extension("femto", sources=[])], cmdclass={"build_ext": CMakeBuild})
+# packages=[]: one extension module and no Python packages (python/src holds C++ only).
+setup(ext_modules=[Extension("femto", sources=[])], packages=[],
+      cmdclass={"build_ext": CMakeBuild})
