@@ -20,6 +20,7 @@
 #include "core/io/sha256.h"
 #include "core/memory_usage.h"
 #include "core/output_folder.h"
+#include "apps/render_flags.h"
 #include "apps/render_record.h"
 #include "apps/tissue_run.h"
 #include "core/tissue/scene.h"
@@ -123,22 +124,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   stop_signals::start();
   cli::Args args("femto render", argv);
   std::string scene_path;
-  std::optional<int> spp, max_depth;
-  std::optional<uint64_t> seed;
-  std::optional<DistanceSampling> sampling;
-  std::optional<TemporalFilter::Kind> reconstruction;
-  std::optional<ConnectionSampling> connection;
-  std::optional<DirectionSampling> direction;
-  std::optional<TemporalKernel> kernel;
-  std::optional<double> alpha, bandwidth;
-  bool no_onset_reflection = false;
-  std::optional<int> knn, first_pass_spp;
-  std::string kernel_flag;  // the first kernel-only flag given, for the error message
-  std::optional<IntegratorKind> integrator;
-  std::optional<int64_t> light_paths, photons_per_pass;
-  std::optional<double> photon_radius, photon_bandwidth;
-  std::string photon_flag;  // the first photon-only flag given, for the error message
-  int threads = 0;
+  RenderOverrides overrides;
   OutputOptions out;
   bool out_given = false;
   bool checkpoint = false;
@@ -151,79 +137,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     if (a == "--help" || a == "-h") {
       std::fputs(kRenderHelp, stdout);
       return 0;
-    } else if (a == "--spp") {
-      spp = static_cast<int>(args.int_value(1, 10000000));
-    } else if (a == "--seed") {
-      seed = args.uint_value();
-    } else if (a == "--threads") {
-      threads = static_cast<int>(args.int_value(0, 4096));
-    } else if (a == "--distance-sampling") {
-      const std::string v = args.value();
-      if (v == "mfp") sampling = DistanceSampling::Mfp;
-      else if (v == "time_uniform") sampling = DistanceSampling::TimeUniform;
-      else if (v == "mis") sampling = DistanceSampling::Mis;
-      else args.fail("expected mfp, time_uniform or mis", v);
-    } else if (a == "--connection-sampling") {
-      const std::string v = args.value();
-      if (v == "collision") connection = ConnectionSampling::Collision;
-      else if (v == "equiangular") connection = ConnectionSampling::Equiangular;
-      else if (v == "line_to_point") connection = ConnectionSampling::LineToPoint;
-      else if (v == "mis") connection = ConnectionSampling::Mis;
-      else if (v == "auto") connection = ConnectionSampling::Auto;
-      else args.fail("expected collision, equiangular, line_to_point, mis or auto", v);
-    } else if (a == "--direction-sampling") {
-      const std::string v = args.value();
-      if (v == "phase") direction = DirectionSampling::Phase;
-      else if (v == "angular") direction = DirectionSampling::Angular;
-      else args.fail("expected phase or angular", v);
-    } else if (a == "--reconstruction") {
-      const std::string v = args.value();
-      if (v == "histogram") reconstruction = TemporalFilter::Kind::Histogram;
-      else if (v == "kernel") reconstruction = TemporalFilter::Kind::Kernel;
-      else args.fail("expected histogram or kernel", v);
-    } else if (a == "--kernel") {
-      const std::string v = args.value();
-      if (v == "perlin") kernel = TemporalKernel::Perlin;
-      else if (v == "epanechnikov") kernel = TemporalKernel::Epanechnikov;
-      else args.fail("expected perlin or epanechnikov", v);
-      if (kernel_flag.empty()) kernel_flag = a;
-    } else if (a == "--alpha") {
-      alpha = args.number_in(0.0, 1.0, true, false, "in (0, 1]");
-      if (kernel_flag.empty()) kernel_flag = a;
-    } else if (a == "--knn") {
-      knn = static_cast<int>(args.int_value(1, 100000));
-      if (kernel_flag.empty()) kernel_flag = a;
-    } else if (a == "--first-pass-spp") {
-      first_pass_spp = static_cast<int>(args.int_value(1, 1000000));
-      if (kernel_flag.empty()) kernel_flag = a;
-    } else if (a == "--bandwidth") {
-      bandwidth = args.number_in(0.0, 1e12, true, false, "in (0, 1e12] ps");
-      if (kernel_flag.empty()) kernel_flag = a;
-    } else if (a == "--no-onset-reflection") {
-      no_onset_reflection = true;
-      if (kernel_flag.empty()) kernel_flag = a;
-    } else if (a == "--integrator") {
-      const std::string v = args.value();
-      if (v == "auto") integrator = IntegratorKind::Auto;
-      else if (v == "path") integrator = IntegratorKind::Path;
-      else if (v == "light") integrator = IntegratorKind::Light;
-      else if (v == "photons") integrator = IntegratorKind::Photons;
-      else if (v == "beams") integrator = IntegratorKind::Beams;
-      else if (v == "hybrid") integrator = IntegratorKind::Hybrid;
-      else args.fail("expected auto, path, light, photons, beams or hybrid", v);
-    } else if (a == "--light-paths") {
-      light_paths = static_cast<int64_t>(args.int_value(1, 1000000000000LL));
-    } else if (a == "--photons") {
-      photons_per_pass = static_cast<int64_t>(args.int_value(1, 1000000000LL));
-      if (photon_flag.empty()) photon_flag = a;
-    } else if (a == "--photon-radius") {
-      photon_radius = args.number_in(0.0, 1e9, true, false, "in (0, 1e9] mm");
-      if (photon_flag.empty()) photon_flag = a;
-    } else if (a == "--photon-bandwidth") {
-      photon_bandwidth = args.number_in(0.0, 1e12, true, false, "in (0, 1e12] ps");
-      if (photon_flag.empty()) photon_flag = a;
-    } else if (a == "--max-depth") {
-      max_depth = static_cast<int>(args.int_value(1, 1000000));
+    } else if (parse_render_flag(args, a, overrides)) {
     } else if (a == "--out") {
       out.dir = args.value();
       if (out.dir.empty()) args.fail("expects a folder", "");
@@ -275,11 +189,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   } else {
     scene_text = read_scene_text(scene_path);  // read once, size-limited
     if (tissue::is_tissue_scene(scene_text)) {  // tissue optics (docs/tissue.md)
-      const char* camera_only = spp ? "--spp" : max_depth ? "--max-depth" : sampling ? "--distance-sampling"
-                              : connection ? "--connection-sampling" : direction ? "--direction-sampling"
-                              : reconstruction ? "--reconstruction" : !kernel_flag.empty() ? "--kernel"
-                              : integrator ? "--integrator" : light_paths ? "--light-paths"
-                              : photon_radius ? "--photon-radius" : photon_bandwidth ? "--photon-bandwidth"
+      const char* camera_only = overrides.camera_only_flag() ? overrides.camera_only_flag()
                               : checkpoint ? "--checkpoint" : !resume_dir.empty() ? "--resume"
                               : !out.previews ? "--no-previews" : nullptr;
       if (camera_only)
@@ -287,9 +197,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                          clip(scene_path, 200) + " (its options: --photons, --seed, --threads, --out, "
                          "--max-memory, --quiet)");
       TissueRunOptions t;
-      if (photons_per_pass) t.photons = static_cast<uint64_t>(*photons_per_pass);
-      t.seed = seed;
-      t.threads = threads;
+      if (overrides.photons_per_pass) t.photons = static_cast<uint64_t>(*overrides.photons_per_pass);
+      t.seed = overrides.seed;
+      t.threads = overrides.threads;
       if (out_given) t.out = out.dir;
       t.quiet = quiet;
       t.max_memory = max_memory;
@@ -298,57 +208,11 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     desc = load_scene_string(scene_text, scene_path,
                              std::filesystem::path(scene_path).parent_path().string());
   }
-  for (MediumDesc& m : desc.media) {
-    if (sampling) m.sampling = *sampling;
-    if (connection) m.connection = *connection;
-    if (direction) m.direction = *direction;
-  }
-  ReconstructionDesc& rec = desc.reconstruction;
-  if (reconstruction) rec.type = *reconstruction;
-  if (!kernel_flag.empty() && rec.type != TemporalFilter::Kind::Kernel)
-    throw InputError("femto render: " + kernel_flag +
-                     ": applies to the kernel film only; add --reconstruction kernel (or set "
-                     "/time/reconstruction in the scene)");
-  if (kernel) rec.kernel = *kernel;
-  if (alpha) rec.alpha = *alpha;
-  if (knn) rec.knn = *knn;
-  if (first_pass_spp) rec.first_pass_spp = *first_pass_spp;
-  if (bandwidth) rec.bandwidth_ps = *bandwidth;
-  if (no_onset_reflection) rec.onset_reflection = false;
-  if (integrator) desc.integrator.kind = *integrator;
-  if (light_paths) desc.integrator.light_paths = *light_paths;
-  PhotonDesc& pd = desc.integrator.photons;
-  if (photons_per_pass) pd.per_pass = *photons_per_pass;
-  if (photon_radius) pd.radius = *photon_radius;
-  if (photon_bandwidth) pd.bandwidth_ps = *photon_bandwidth;
-  std::string integrator_why;
-  const IntegratorKind kind = resolve_integrator(desc, desc.integrator.kind, integrator_why);
   const std::string where = scene_path.empty() ? "femto render" : scene_path;
-  if (kind != IntegratorKind::Path && rec.type == TemporalFilter::Kind::Kernel)
-    throw InputError(where + ": integrator \"" + integrator_name(kind) +
-                     "\": the kernel film (/time/reconstruction kernel) works with camera paths only; use "
-                     "--integrator path or the histogram film");
-  if (!photon_flag.empty() && kind != IntegratorKind::Photons && kind != IntegratorKind::Beams &&
-      kind != IntegratorKind::Hybrid)
-    throw InputError("femto render: " + photon_flag +
-                     ": applies to photon mapping and photon beams only, but the integrator is \"" +
-                     integrator_name(kind) + "\"; add --integrator photons or beams");
-  const bool scattering = std::any_of(desc.media.begin(), desc.media.end(), [](const MediumDesc& m) {
-    return m.type == MediumDesc::Type::Vdb || m.medium.sigma_s > 0;
-  });
-  if (kind == IntegratorKind::Beams && !scattering)
-    throw InputError(where + ": integrator \"beams\": the scene has no scattering medium, so there are no beams "
-                             "to gather; use --integrator path, light or photons");
-  if (light_paths && kind != IntegratorKind::Light)
-    throw InputError("femto render: --light-paths: applies to --integrator light only");
-  RenderOptions opt;
-  opt.integrator = kind;
-  opt.light_paths = desc.integrator.light_paths;
-  opt.photons = pd;
-  opt.spp = spp.value_or(desc.integrator.spp);
-  opt.seed = seed.value_or(desc.integrator.seed);
-  opt.max_depth = max_depth.value_or(desc.integrator.max_depth);
-  opt.threads = threads;
+  RenderSetup setup = apply_render_overrides(desc, overrides, args.command(), where);
+  const IntegratorKind kind = setup.kind;
+  RenderOptions& opt = setup.options;
+  const ReconstructionDesc& rec = desc.reconstruction;
   opt.quiet = quiet;
   const CameraDesc& cam = desc.camera;
   const TimeAxis axis = desc.time;
@@ -363,7 +227,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   // between passes, per-thread buffers, a photon pass or a light-splat batch, and the buffers of
   // writing the outputs (core/render.h, render_memory).
   const int hardware_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const int threads_used = threads > 0 ? std::min(threads, hardware_threads) : hardware_threads;
+  const int threads_used = opt.threads > 0 ? std::min(opt.threads, hardware_threads) : hardware_threads;
   const RenderMemory mem = render_memory(cam.width, cam.height, axis.bins, opt, threads_used, kernel_film,
                                          rec.first_pass_spp, out.frames == OutputOptions::Frames::Multipart);
   const uint64_t render_bytes = mem.peak();
@@ -467,87 +331,15 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   RenderResult result = render(scene, opt);
   const PathStats& st = result.stats;
   const uint64_t film_nonfinite = result.film.zero_nonfinite();  // outputs stay finite
-  const std::string depth_source = max_depth_source(max_depth.has_value(), scene.desc().integrator);
+  const std::string depth_source = max_depth_source(overrides.max_depth.has_value(), scene.desc().integrator);
 
-  nlohmann::json info;
-  info["femto_version"] = FEMTO_VERSION;
-  info["femto_build"] = FEMTO_GIT_DESCRIBE;
-  info["command"] = command_line;
-  info["date_utc"] = cli::utc_now();
-  info["scene"] = {{"source", scene.desc().source},
-                   {"json", scene_json(scene_text)}};
-  info["settings"] = {{"spp", opt.spp},
-                      {"seed", opt.seed},
-                      {"threads", result.threads},
-                      {"threads_requested", threads},
-                      {"mpi_ranks", comm.size()},
-                      {"max_depth", opt.max_depth},
-                      {"max_depth_source", depth_source},
-                      {"integrator", integrator_json(kind, integrator_why, opt, result)},
-                      {"reconstruction", reconstruction_json(scene.desc().reconstruction, result)},
-                      {"russian_roulette", false}};
-  nlohmann::json media = nlohmann::json::array();
-  {
-    const char* names[] = {"mfp", "time_uniform", "mis"};
-    for (size_t i = 0; i < scene.desc().media.size(); ++i) {
-      const MediumDesc& md = scene.desc().media[i];
-      const Medium& rm = scene.media()[i];
-      nlohmann::json e = {{"name", md.name},
-                          {"type", md.type == MediumDesc::Type::Vdb ? "vdb" : "homogeneous"},
-                          {"distance_sampling", names[static_cast<int>(md.sampling)]}};
-      if (md.sampling != DistanceSampling::Mfp) e["time_uniform_rate_per_mm_opl"] = rm.strategy.lambda;
-      if (md.sampling == DistanceSampling::Mis)
-        e["mis_heuristic"] = md.mis_heuristic == MisHeuristic::Power ? "power" : "balance";
-      e["connection_sampling"] = connection_sampling_name(md.connection);
-      e["direction_sampling"] = md.direction == DirectionSampling::Angular ? "angular" : "phase";
-      media.push_back(e);
-    }
-  }
-  info["media"] = media;
-  info["time_axis"] = {{"t_start_ps", axis.t_start_ps},
-                       {"bin_width_ps", axis.bin_width_ps},
-                       {"bins", axis.bins},
-                       {"t_end_ps", axis.t_end_ps()},
-                       {"start_opl_mm", TimeAxis::opl_of_time(axis.t_start_ps)},
-                       {"bin_width_opl_mm", TimeAxis::opl_of_time(axis.bin_width_ps)},
-                       {"end_opl_mm", TimeAxis::opl_of_time(axis.t_end_ps())},
-                       {"mode", scene.desc().time_mode == TimeMode::Camera ? "camera" : "unwarp"},
-                       {"speed_of_light_mm_per_ps", kSpeedOfLight}};
-  info["film"] = {{"width", cam.width},
-                  {"height", cam.height},
-                  {"bins", axis.bins},
-                  {"npy_shape", {cam.height, cam.width, axis.bins, 3}},
-                  {"dtype", "float32"},
-                  {"units", "radiance integrated over each bin; sum over bins = steady.exr"},
-                  {"memory_bytes", film_bytes}};
-  info["counters"] = {{"paths", st.paths},
-                      {"medium_scattering_events", st.medium_events},
-                      {"surface_events", st.surface_events},
-                      {"null_boundary_crossings", st.null_crossings},
-                      {"max_depth_terminations", st.max_depth_hits},
-                      {"nonfinite_samples_dropped", st.nonfinite_dropped},
-                      {"nonfinite_film_values_zeroed", film_nonfinite},
-                      {"light_paths", st.light_paths},
-                      {"photons_stored", st.photons_stored},
-                      {"photon_gathers", st.photon_gathers},
-                      {"beams_stored", st.beams_stored},
-                      {"beam_gathers", st.beam_gathers}};
-  info["timing"] = {{"render_seconds", result.wall_seconds},
-                    {"paths_per_second", result.wall_seconds > 0 ? static_cast<double>(st.paths) / result.wall_seconds : 0.0}};
   const int stop_signal = stop_signals::signal_number();
-  info["complete"] = result.complete;
-  info["progress"] = {{"complete", result.complete},
-                      {"unit", result.unit},
-                      {"units_done", result.units_done},
-                      {"units_total", result.units_total},
-                      {"spp_done", result.spp_done},
-                      {"sessions", result.sessions},
-                      {"stopped_by", result.complete ? nlohmann::json(nullptr)
-                                     : stop_signal == SIGTERM ? nlohmann::json("SIGTERM")
-                                                              : nlohmann::json("SIGINT")}};
-  if (kind == IntegratorKind::Light) info["progress"]["light_paths_done"] = result.light_paths;
-  if (kernel_film && !result.complete)
-    info["progress"]["rows_done"] = std::min<int64_t>(cam.height, result.units_done * 16);
+  nlohmann::json info =
+      render_info(scene, scene_text, setup, overrides.max_depth.has_value(), result, film_nonfinite,
+                  result.complete ? nullptr : stop_signal == SIGTERM ? "SIGTERM" : "SIGINT");
+  info["command"] = command_line;
+  info["settings"]["mpi_ranks"] = comm.size();
+  info["date_utc"] = cli::utc_now();
   info["checkpoint"] = {{"enabled", checkpoint},
                         {"every_seconds", checkpoint_every},
                         {"resumed_from", resume_dir.empty() ? nlohmann::json(nullptr) : nlohmann::json(resume_dir)},
@@ -563,11 +355,6 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                       {"outputs", mem.outputs}}},
                     {"max_memory_bytes", max_memory},
                     {"peak_rss_bytes", 0}};
-  info["energy"] = {{"in_window", rgb_json(result.film.total_steady())},
-                    {"before_window", rgb_json(result.film.total_before())},
-                    {"after_window", rgb_json(result.film.total_after())},
-                    {"note", "sums over pixels; after_window only counts contributions of paths "
-                             "still alive (paths stop once they pass the window end)"}};
   const std::vector<std::string> files = write_outputs(result.film, staged, info, result.final_bandwidth_ps);
   folder.commit();
   if (!quiet) {

@@ -169,4 +169,98 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
             {"film", {desc.camera.width, desc.camera.height, desc.time.bins}}}}};
 }
 
+nlohmann::json render_info(const Scene& scene, const std::string& scene_text, const RenderSetup& setup,
+                           bool max_depth_given, const RenderResult& result, uint64_t film_nonfinite,
+                           const char* stopped_by) {
+  const RenderOptions& opt = setup.options;
+  const IntegratorKind kind = setup.kind;
+  const std::string& integrator_why = setup.integrator_why;
+  const CameraDesc& cam = scene.desc().camera;
+  const TimeAxis& axis = scene.desc().time;
+  const bool kernel_film = scene.desc().reconstruction.type == TemporalFilter::Kind::Kernel;
+  const uint64_t film_bytes = TransientFilm::memory_bytes(cam.width, cam.height, axis.bins);
+  const PathStats& st = result.stats;
+  const std::string depth_source = max_depth_source(max_depth_given, scene.desc().integrator);
+  nlohmann::json info;
+  info["femto_version"] = FEMTO_VERSION;
+  info["femto_build"] = FEMTO_GIT_DESCRIBE;
+  info["scene"] = {{"source", scene.desc().source},
+                   {"json", scene_json(scene_text)}};
+  info["settings"] = {{"spp", opt.spp},
+                      {"seed", opt.seed},
+                      {"threads", result.threads},
+                      {"threads_requested", opt.threads},
+                      {"max_depth", opt.max_depth},
+                      {"max_depth_source", depth_source},
+                      {"integrator", integrator_json(kind, integrator_why, opt, result)},
+                      {"reconstruction", reconstruction_json(scene.desc().reconstruction, result)},
+                      {"russian_roulette", false}};
+  nlohmann::json media = nlohmann::json::array();
+  {
+    const char* names[] = {"mfp", "time_uniform", "mis"};
+    for (size_t i = 0; i < scene.desc().media.size(); ++i) {
+      const MediumDesc& md = scene.desc().media[i];
+      const Medium& rm = scene.media()[i];
+      nlohmann::json e = {{"name", md.name},
+                          {"type", md.type == MediumDesc::Type::Vdb ? "vdb" : "homogeneous"},
+                          {"distance_sampling", names[static_cast<int>(md.sampling)]}};
+      if (md.sampling != DistanceSampling::Mfp) e["time_uniform_rate_per_mm_opl"] = rm.strategy.lambda;
+      if (md.sampling == DistanceSampling::Mis)
+        e["mis_heuristic"] = md.mis_heuristic == MisHeuristic::Power ? "power" : "balance";
+      e["connection_sampling"] = connection_sampling_name(md.connection);
+      e["direction_sampling"] = md.direction == DirectionSampling::Angular ? "angular" : "phase";
+      media.push_back(e);
+    }
+  }
+  info["media"] = media;
+  info["time_axis"] = {{"t_start_ps", axis.t_start_ps},
+                       {"bin_width_ps", axis.bin_width_ps},
+                       {"bins", axis.bins},
+                       {"t_end_ps", axis.t_end_ps()},
+                       {"start_opl_mm", TimeAxis::opl_of_time(axis.t_start_ps)},
+                       {"bin_width_opl_mm", TimeAxis::opl_of_time(axis.bin_width_ps)},
+                       {"end_opl_mm", TimeAxis::opl_of_time(axis.t_end_ps())},
+                       {"mode", scene.desc().time_mode == TimeMode::Camera ? "camera" : "unwarp"},
+                       {"speed_of_light_mm_per_ps", kSpeedOfLight}};
+  info["film"] = {{"width", cam.width},
+                  {"height", cam.height},
+                  {"bins", axis.bins},
+                  {"npy_shape", {cam.height, cam.width, axis.bins, 3}},
+                  {"dtype", "float32"},
+                  {"units", "radiance integrated over each bin; sum over bins = steady.exr"},
+                  {"memory_bytes", film_bytes}};
+  info["counters"] = {{"paths", st.paths},
+                      {"medium_scattering_events", st.medium_events},
+                      {"surface_events", st.surface_events},
+                      {"null_boundary_crossings", st.null_crossings},
+                      {"max_depth_terminations", st.max_depth_hits},
+                      {"nonfinite_samples_dropped", st.nonfinite_dropped},
+                      {"nonfinite_film_values_zeroed", film_nonfinite},
+                      {"light_paths", st.light_paths},
+                      {"photons_stored", st.photons_stored},
+                      {"photon_gathers", st.photon_gathers},
+                      {"beams_stored", st.beams_stored},
+                      {"beam_gathers", st.beam_gathers}};
+  info["timing"] = {{"render_seconds", result.wall_seconds},
+                    {"paths_per_second", result.wall_seconds > 0 ? static_cast<double>(st.paths) / result.wall_seconds : 0.0}};
+  info["complete"] = result.complete;
+  info["progress"] = {{"complete", result.complete},
+                      {"unit", result.unit},
+                      {"units_done", result.units_done},
+                      {"units_total", result.units_total},
+                      {"spp_done", result.spp_done},
+                      {"sessions", result.sessions},
+                      {"stopped_by", stopped_by ? nlohmann::json(stopped_by) : nlohmann::json(nullptr)}};
+  if (kind == IntegratorKind::Light) info["progress"]["light_paths_done"] = result.light_paths;
+  if (kernel_film && !result.complete)
+    info["progress"]["rows_done"] = std::min<int64_t>(cam.height, result.units_done * 16);
+
+  info["energy"] = {{"in_window", rgb_json(result.film.total_steady())},
+                    {"before_window", rgb_json(result.film.total_before())},
+                    {"after_window", rgb_json(result.film.total_after())},
+                    {"note", "sums over pixels; after_window only counts contributions of paths "
+                             "still alive (paths stop once they pass the window end)"}};
+  return info;
+}
+
 }  // namespace femto

@@ -6,7 +6,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/render_flags.h"
 #include "core/render.h"
+#include "core/scene.h"
 
 namespace femto {
 
@@ -26,5 +28,12 @@ const char* sampling_name(DistanceSampling s);
 /// Everything that decides the bits of a render, for checkpoints: a resume must match it.
 nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc& desc,
                                   IntegratorKind kind, const RenderOptions& opt);
+
+/// render.json's record of a render, without the command line and date: version, scene, settings,
+/// media, time axis, film, counters, timing, progress (`stopped_by`: null when complete) and
+/// energy. `film_nonfinite`: the values TransientFilm::zero_nonfinite set to 0.
+nlohmann::json render_info(const Scene& scene, const std::string& scene_text, const RenderSetup& setup,
+                           bool max_depth_given, const RenderResult& result, uint64_t film_nonfinite,
+                           const char* stopped_by);
 
 }  // namespace femto
