@@ -338,7 +338,6 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       render_info(scene, scene_text, setup, overrides.max_depth.has_value(), result, film_nonfinite,
                   result.complete ? nullptr : stop_signal == SIGTERM ? "SIGTERM" : "SIGINT");
   info["command"] = command_line;
-  info["settings"]["mpi_ranks"] = comm.size();
   info["date_utc"] = cli::utc_now();
   info["checkpoint"] = {{"enabled", checkpoint},
                         {"every_seconds", checkpoint_every},

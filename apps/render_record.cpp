@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "core/distributed/comm.h"
 #include "core/io/sha256.h"
 #include "femto_version.h"
 
@@ -190,6 +191,7 @@ nlohmann::json render_info(const Scene& scene, const std::string& scene_text, co
                       {"seed", opt.seed},
                       {"threads", result.threads},
                       {"threads_requested", opt.threads},
+                      {"mpi_ranks", opt.comm ? opt.comm->size() : 1},
                       {"max_depth", opt.max_depth},
                       {"max_depth_source", depth_source},
                       {"integrator", integrator_json(kind, integrator_why, opt, result)},
