@@ -100,7 +100,8 @@ const char* kRenderHelp =
     "                     on it and listed in render.json) or log (log10 of luminance over\n"
     "                     --log-decades below white: late, dim frames stay visible)\n"
     "  --exposure EV      brighten (or darken, EV < 0) the automatic exposure by 2^EV\n"
-    "  --log-decades D    --tonemap log: decades from white to black, 0.5..12 (default 4)\n"
+    "  --log-decades D    --tonemap log: decades from white to black, 0.5..12, or auto (the\n"
+    "                     default: down to the dimmest frame's own exposure, plus one decade)\n"
     "  --max-memory SIZE  refuse to render when it needs more than SIZE (e.g. 2G): film,\n"
     "                     sums, buffers and volumes; default 75% of physical memory\n"
     "  --checkpoint       write DIR/checkpoint.bin (DIR = --out) every 60 s, atomically, and\n"
@@ -270,7 +271,12 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       out.tonemap.exposure_stops = args.number_in(-30.0, 30.0, false, false, "in [-30, 30] stops");
       if (tonemap_flag.empty()) tonemap_flag = a;
     } else if (a == "--log-decades") {
-      out.tonemap.log_decades = args.number_in(0.5, 12.0, false, false, "in [0.5, 12]");
+      const std::string v = args.value();
+      char* end = nullptr;
+      const double d = std::strtod(v.c_str(), &end);
+      if (v == "auto") out.tonemap.log_decades = 0;
+      else if (v.empty() || *end != '\0' || !(d >= 0.5 && d <= 12)) args.fail("expected 0.5..12 or auto", v);
+      else out.tonemap.log_decades = d;
       log_flag = a;
       if (tonemap_flag.empty()) tonemap_flag = a;
     } else if (a == "--max-memory") {

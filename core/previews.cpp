@@ -39,10 +39,25 @@ std::vector<ToneCurve> frame_tone_curves(const TransientFilm& film,
     chosen.insert(chosen.end(), f.begin(), f.end());
   }
   const double scale = auto_scale(chosen.data(), chosen.size() / 3, settings.exposure_stops);
+  double decades = settings.log_decades;
+  if (settings.mode == ToneMapMode::Log && !(decades > 0)) {
+    // Down to the dimmest lit bin's automatic white, so every frame with light shows.
+    double dimmest_scale = scale;
+    for (int t = 0; t < T; ++t) {
+      const std::vector<float> f = film.frame(t);
+      bool lit = false;
+      for (size_t i = 0; i < pixels && !lit; ++i) {
+        const double L = 0.2126 * f[3 * i] + 0.7152 * f[3 * i + 1] + 0.0722 * f[3 * i + 2];
+        lit = L > 0 && std::isfinite(L);
+      }
+      if (lit) dimmest_scale = std::max(dimmest_scale, auto_scale(f.data(), pixels, settings.exposure_stops));
+    }
+    decades = std::clamp(std::log10(dimmest_scale / scale) + 1, 1.0, 12.0);
+  }
   for (ToneCurve& c : curves) {
     c.scale = scale;
     c.log = settings.mode == ToneMapMode::Log;
-    c.decades = settings.log_decades;
+    c.decades = decades;
   }
   return curves;
 }
@@ -148,7 +163,10 @@ nlohmann::json tone_mapping_json(const ToneMapSettings& settings,
                                  const std::vector<ToneCurve>& curves) {
   nlohmann::json j = {{"mode", tone_map_name(settings.mode)},
                       {"exposure_stops", settings.exposure_stops}};
-  if (settings.mode == ToneMapMode::Log) j["log_decades"] = settings.log_decades;
+  if (settings.mode == ToneMapMode::Log) {
+    j["log_decades"] = curves.empty() ? settings.log_decades : curves.front().decades;
+    j["log_decades_source"] = settings.log_decades > 0 ? "--log-decades" : "auto";
+  }
   if (settings.mode == ToneMapMode::PerFrame) {
     nlohmann::json w = nlohmann::json::array();
     for (const ToneCurve& c : curves) w.push_back(c.white_radiance());

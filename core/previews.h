@@ -15,6 +15,8 @@ namespace femto {
 
 /// The tone curve of every bin of a film: Global and Log use the automatic exposure of the
 /// contact sheet's frames (contact_sheet_frames) together, PerFrame that of each bin alone.
+/// Log with automatic decades spans from white down to the dimmest bin's own white (over the
+/// bins with light), plus one decade, within [1, 12].
 std::vector<ToneCurve> frame_tone_curves(const TransientFilm& film,
                                          const ToneMapSettings& settings);
 

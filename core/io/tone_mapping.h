@@ -17,7 +17,9 @@ enum class ToneMapMode {
 struct ToneMapSettings {
   ToneMapMode mode = ToneMapMode::Global;
   double exposure_stops = 0;  ///< brightens by 2^stops from the automatic exposure
-  double log_decades = 4;     ///< Log: luminance range (decades) from white down to black
+  /// Log: luminance range (decades) from white down to black; <= 0: automatic, one decade more
+  /// than the frames' automatic exposures span (frame_tone_curves, core/previews.h)
+  double log_decades = 0;
 };
 
 /// "global", "per-frame", "log".
