@@ -50,7 +50,9 @@ std::vector<ToneCurve> frame_tone_curves(const TransientFilm& film,
         const double L = 0.2126 * f[3 * i] + 0.7152 * f[3 * i + 1] + 0.0722 * f[3 * i + 2];
         lit = L > 0 && std::isfinite(L);
       }
-      if (lit) dimmest_scale = std::max(dimmest_scale, auto_scale(f.data(), pixels, settings.exposure_stops));
+      if (lit)
+        dimmest_scale =
+            std::max(dimmest_scale, auto_scale(f.data(), pixels, settings.exposure_stops));
     }
     decades = std::clamp(std::log10(dimmest_scale / scale) + 1, 1.0, 12.0);
   }

@@ -46,18 +46,24 @@ void check_spec(const std::string& path, const VideoSpec& spec, int frames) {
                        std::to_string(spec.height) + " at " + std::to_string(spec.fps) + " fps");
 }
 
-// Frame i from the caller, padded with black to the even size.
+// Frame i from the caller, padded to the even size by repeating the last column and row (black
+// would bleed into the subsampled chroma of the edge pixels).
 void padded_frame(const VideoSpec& spec, int i,
                   const std::function<void(int, std::vector<uint8_t>&)>& frame,
                   std::vector<uint8_t>& rgb, std::vector<uint8_t>& padded) {
   const size_t w = static_cast<size_t>(spec.width), h = static_cast<size_t>(spec.height);
-  const size_t wp = static_cast<size_t>(even(spec.width));
+  const size_t wp = static_cast<size_t>(even(spec.width)),
+               hp = static_cast<size_t>(even(spec.height));
   rgb.assign(w * h * 3, 0);
   frame(i, rgb);
   if (rgb.size() != w * h * 3)
     throw RuntimeError("video frame " + std::to_string(i) + " has the wrong size");
-  padded.assign(wp * static_cast<size_t>(even(spec.height)) * 3, 0);
-  for (size_t y = 0; y < h; ++y) std::copy_n(&rgb[y * w * 3], w * 3, &padded[y * wp * 3]);
+  padded.resize(wp * hp * 3);
+  for (size_t y = 0; y < hp; ++y) {
+    const size_t sy = std::min(y, h - 1);
+    std::copy_n(&rgb[sy * w * 3], w * 3, &padded[y * wp * 3]);
+    if (wp > w) std::copy_n(&rgb[(sy * w + w - 1) * 3], 3, &padded[(y * wp + w) * 3]);
+  }
 }
 
 // The `ffmpeg` program on PATH, or "".
@@ -100,35 +106,15 @@ std::string write_with_program(const std::string& path, const std::string& tmp,
   const std::string size =
       std::to_string(even(spec.width)) + "x" + std::to_string(even(spec.height));
   const std::string log = tmp + ".log";
-  std::vector<std::string> args = {"ffmpeg",
-                                   "-nostdin",
-                                   "-hide_banner",
-                                   "-loglevel",
-                                   "error",
-                                   "-f",
-                                   "rawvideo",
-                                   "-pix_fmt",
-                                   "rgb24",
-                                   "-s",
-                                   size,
-                                   "-framerate",
-                                   std::to_string(spec.fps),
-                                   "-i",
-                                   "pipe:0",
-                                   "-c:v",
-                                   encoder,
-                                   "-threads",
-                                   "1",
-                                   "-pix_fmt",
-                                   "yuv420p",
-                                   "-color_primaries",
-                                   "bt709",
-                                   "-color_trc",
-                                   "iec61966-2-1",
-                                   "-colorspace",
-                                   "bt709",
-                                   "-color_range",
-                                   "tv"};
+  // clang-format off
+  std::vector<std::string> args = {
+      "ffmpeg", "-nostdin", "-hide_banner", "-loglevel", "error",
+      "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", size, "-framerate", std::to_string(spec.fps), "-i", "pipe:0",
+      // BT.709 limited range, as the stream is tagged (swscale's default matrix is BT.601).
+      "-vf", "scale=out_color_matrix=bt709:out_range=tv", "-c:v", encoder, "-threads", "1",
+      "-pix_fmt", "yuv420p", "-color_primaries", "bt709", "-color_trc", "iec61966-2-1",
+      "-colorspace", "bt709", "-color_range", "tv"};
+  // clang-format on
   if (encoder == "libx264") args.insert(args.end(), {"-crf", "18", "-preset", "medium"});
   args.insert(args.end(), {"-f", "mp4", "-y", tmp});
   std::vector<char*> argv;
@@ -301,6 +287,9 @@ std::string write_with_libraries(const std::string& path, const std::string& tmp
   auto encode = [&](AVFrame* f) {
     if ((err = avcodec_send_frame(ctx.get(), f)) < 0) throw fail("encoding failed", err);
     while ((err = avcodec_receive_packet(ctx.get(), packet.get())) >= 0) {
+      // One frame long: the MP4 edit list ends at the last frame's pts + duration, so a
+      // missing duration would cut the last frame from playback.
+      if (packet->duration == 0) packet->duration = 1;
       av_packet_rescale_ts(packet.get(), ctx->time_base, stream->time_base);
       packet->stream_index = stream->index;
       err = av_interleaved_write_frame(format.get(), packet.get());  // takes the packet's data

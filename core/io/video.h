@@ -14,7 +14,7 @@ enum class VideoBackend {
 };
 
 struct VideoSpec {
-  int width = 0, height = 0;  ///< of the frames given; odd sizes are padded with black to even
+  int width = 0, height = 0;  ///< of the frames given; odd sizes are padded to even (edge repeated)
   int fps = 24;               ///< frames per second, 1..240
   std::string encoder;        ///< FFmpeg encoder name; empty: libx264, else any H.264 encoder
 };
