@@ -166,6 +166,13 @@ TEST_CASE("video failures are clear and leave nothing behind", "[video]") {
                             backend),
                         "frame source failed");
     CHECK(leftovers(tmp.dir).empty());
+    // An encoder of another codec is refused, not used.
+    CHECK(check_h264_encoder("", backend) == "libx264");
+    spec.encoder = "mpeg4";
+    CHECK_THROWS_WITH(write_mp4_h264(
+                          path, spec, 2, [](int, std::vector<uint8_t>&) {}, backend),
+                      Catch::Contains("--video-encoder mpeg4: not an H.264 encoder"));
+    CHECK(leftovers(tmp.dir).empty());
     // An encoder the backend does not have.
     spec.encoder = "no-such-encoder";
     CHECK_THROWS(write_mp4_h264(

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -121,14 +122,21 @@ std::string write_with_program(const std::string& path, const std::string& tmp,
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
 
+  // ffmpeg's messages go to a file beside the output (a pipe could fill and block it).
+  const int log_fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (log_fd < 0) throw RuntimeError(path + ": cannot create the file: " + std::strerror(errno));
   int pipe_fd[2];
-  if (::pipe2(pipe_fd, O_CLOEXEC) != 0)
-    throw RuntimeError(path + ": cannot start ffmpeg: " + std::strerror(errno));
+  if (::pipe2(pipe_fd, O_CLOEXEC) != 0) {
+    const int err = errno;
+    ::close(log_fd);
+    ::unlink(log.c_str());
+    throw RuntimeError(path + ": cannot start ffmpeg: " + std::strerror(err));
+  }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, pipe_fd[0], 0);
   posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, log_fd, 2);
   posix_spawnattr_t attr;
   posix_spawnattr_init(&attr);
   sigset_t none, defaults;
@@ -146,6 +154,7 @@ std::string write_with_program(const std::string& path, const std::string& tmp,
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
   ::close(pipe_fd[0]);
+  ::close(log_fd);
   if (spawned != 0) {
     ::close(pipe_fd[1]);
     ::unlink(log.c_str());
@@ -340,7 +349,27 @@ std::string check_h264_encoder(const std::string& encoder, VideoBackend backend)
           (video_libraries_built_in() ? "backend chosen" : "(FEMTO_VIDEO)") +
           " and there is no `ffmpeg` program on PATH; install ffmpeg (Debian: apt-get install "
           "ffmpeg)");
-    return encoder.empty() ? "libx264" : encoder;
+    const std::string name = encoder.empty() ? "libx264" : encoder;
+    if (name.find_first_not_of(
+            "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
+        std::string::npos)
+      throw InputError("--video-encoder " + clip(encoder) + ": not an FFmpeg encoder name");
+    // "Encoder libx264 [libx264 H.264 / AVC / ...]:" for an H.264 encoder.
+    std::string help;
+    if (FILE* p = ::popen(
+            (find_ffmpeg_program() + " -hide_banner -h encoder=" + name + " 2>&1").c_str(), "r")) {
+      char buf[512];
+      if (std::fgets(buf, sizeof buf, p)) help = buf;
+      while (std::fgets(buf, sizeof buf, p)) {
+      }
+      ::pclose(p);
+    }
+    if (help.rfind("Encoder ", 0) != 0)
+      throw InputError("--video-encoder " + clip(name) +
+                       ": the ffmpeg program has no such encoder (see ffmpeg -encoders)");
+    if (help.find("H.264") == std::string::npos)
+      throw InputError("--video-encoder " + clip(name) + ": not an H.264 encoder (e.g. libx264)");
+    return name;
   }
 #ifdef FEMTO_HAVE_LIBAV
   const AVCodec* codec = find_encoder(encoder);
@@ -362,16 +391,17 @@ std::string write_mp4_h264(const std::string& path, const VideoSpec& spec, int f
                            const std::function<void(int, std::vector<uint8_t>&)>& frame,
                            VideoBackend backend) {
   check_spec(path, spec, frames);
+  VideoSpec checked = spec;
+  checked.encoder = check_h264_encoder(spec.encoder, backend);  // H.264 only, never another codec
   std::string used;
   write_atomically(path, [&](const std::string& tmp) {
 #ifdef FEMTO_HAVE_LIBAV
     if (backend == VideoBackend::Libraries) {
-      used = write_with_libraries(path, tmp, spec, frames, frame);
+      used = write_with_libraries(path, tmp, checked, frames, frame);
       return;
     }
 #endif
-    if (backend == VideoBackend::Libraries) check_h264_encoder(spec.encoder, backend);  // throws
-    used = write_with_program(path, tmp, spec, frames, frame);
+    used = write_with_program(path, tmp, checked, frames, frame);
   });
   return used;
 }

@@ -27,8 +27,8 @@ const char* video_backend_name(VideoBackend backend);
 
 /// Checks, before anything is rendered, that `backend` can encode H.264 with `encoder` (empty:
 /// the automatic choice); returns the encoder's name. Throws InputError naming the encoder (not
-/// found, or not an H.264 encoder) or the missing `ffmpeg` program. The Program backend only
-/// checks that the program exists; it reports an unknown encoder when writing.
+/// found, or not an H.264 encoder) or the missing `ffmpeg` program (the Program backend asks it
+/// with `ffmpeg -h encoder=NAME`).
 std::string check_h264_encoder(const std::string& encoder, VideoBackend backend);
 
 /// Writes `frames` frames as H.264 (yuv420p, BT.709, sRGB transfer) in MP4 at `path`, atomically
