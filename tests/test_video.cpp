@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -139,6 +140,14 @@ TEST_CASE("video failures are clear and leave nothing behind", "[video]") {
     } catch (const InputError& e) {
       CHECK(std::string(e.what()).find("not an H.264 encoder") != std::string::npos);
     }
+  }
+  {
+    // No ffmpeg program (PATH without it): the program backend says so before anything is written.
+    const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+    ::setenv("PATH", "/nonexistent", 1);
+    CHECK_THROWS_WITH(check_h264_encoder("", VideoBackend::Program),
+                      Catch::Contains("no `ffmpeg` program on PATH; install ffmpeg"));
+    ::setenv("PATH", path.c_str(), 1);
   }
   for (VideoBackend backend : backends()) {
     INFO(video_backend_name(backend));

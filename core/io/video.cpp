@@ -100,9 +100,7 @@ std::string write_with_program(const std::string& path, const std::string& tmp,
                                const VideoSpec& spec, int frames,
                                const std::function<void(int, std::vector<uint8_t>&)>& frame) {
   const std::string program = find_ffmpeg_program();
-  if (program.empty())
-    throw InputError(
-        "--video: no `ffmpeg` program on PATH and femto is built without the FFmpeg libraries");
+  if (program.empty()) throw InputError("--video: no `ffmpeg` program on PATH");
   const std::string encoder = spec.encoder.empty() ? "libx264" : spec.encoder;
   const std::string size =
       std::to_string(even(spec.width)) + "x" + std::to_string(even(spec.height));
@@ -344,11 +342,12 @@ const char* video_backend_name(VideoBackend backend) {
 std::string check_h264_encoder(const std::string& encoder, VideoBackend backend) {
   if (backend == VideoBackend::Program) {
     if (find_ffmpeg_program().empty())
-      throw InputError(
-          std::string("--video: no H.264 encoder: femto is built without the FFmpeg libraries ") +
-          (video_libraries_built_in() ? "backend chosen" : "(FEMTO_VIDEO)") +
-          " and there is no `ffmpeg` program on PATH; install ffmpeg (Debian: apt-get install "
-          "ffmpeg)");
+      throw InputError(std::string("--video: no H.264 encoder: ") +
+                       (video_libraries_built_in()
+                            ? "the ffmpeg program was asked for"
+                            : "femto is built without the FFmpeg libraries (FEMTO_VIDEO)") +
+                       " and there is no `ffmpeg` program on PATH; install ffmpeg (Debian: apt-get "
+                       "install ffmpeg)");
     const std::string name = encoder.empty() ? "libx264" : encoder;
     if (name.find_first_not_of(
             "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
