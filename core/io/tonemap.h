@@ -21,7 +21,8 @@ double auto_exposure(const float* rgb, size_t pixels);
 /// time (exposure_scale <= 0: auto_exposure over all chosen frames together). labels[i], if
 /// present and non-empty, is drawn in the tile's top-left corner with a built-in 5x7 font
 /// (digits, a-z (A-Z drawn lower case), space and . , - + = : / ( ) _ % ; others draw '?';
-/// '\n' starts a new line), doubled in size on tiles at least 256x128. Returns sheet_width*sheet_height*3 bytes, sRGB.
+/// '\n' starts a new line), doubled in size on tiles at least 256x128. Returns
+/// sheet_width*sheet_height*3 bytes, sRGB.
 /// Throws RuntimeError on an empty selection, an out-of-range frame index or bad dimensions.
 std::vector<uint8_t> contact_sheet_rgb8(int width, int height, int bins, const float* hwtc,
                                         const std::vector<int>& frame_indices,
