@@ -435,6 +435,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   }
   // A missing H.264 encoder is found before rendering, not after.
   if (out.video) out.video_spec.encoder = check_h264_encoder(out.video_spec.encoder, out.video_backend);
+  if (out.video && (cam.width > 16384 || cam.height > 16384))
+    throw InputError("--video: the film is " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
+                     " pixels; the video is limited to 16384 on each side (render without --video)");
   // The output folder is checked before the (possibly long) scene build: a foreign or
   // unwritable --out is bad input.
   {
