@@ -91,7 +91,19 @@ const char* kRenderHelp =
     "  --out DIR          output folder, created if missing (default ./femto-out)\n"
     "  --frames MODE      per-bin EXR frames: files (frames/*.exr, default), multipart\n"
     "                     (one transient.exr with a part per bin) or none\n"
-    "  --no-previews      skip the PNG previews (steady.png, frames.png)\n"
+    "  --no-previews      skip the PNG previews (steady.png, frames.png, peak_time.png)\n"
+    "  --video            also write transient.mp4: H.264, one frame per time bin, each\n"
+    "                     stamped with its start time (FFmpeg libraries, or the ffmpeg program)\n"
+    "  --video-fps N      frames (time bins) per second of the video, 1..240 (default 24)\n"
+    "  --video-encoder E  FFmpeg H.264 encoder (default libx264, else any H.264 encoder)\n"
+    "  --tonemap M        how frames.png and transient.mp4 show the frames: global (one\n"
+    "                     automatic exposure for all frames, the default), per-frame (each\n"
+    "                     frame exposed on its own; the radiance shown as white is stamped\n"
+    "                     on it and listed in render.json) or log (log10 of luminance over\n"
+    "                     --log-decades below white: late, dim frames stay visible)\n"
+    "  --exposure EV      brighten (or darken, EV < 0) the automatic exposure by 2^EV\n"
+    "  --log-decades D    --tonemap log: decades from white to black, 0.5..12, or auto (the\n"
+    "                     default: down to the dimmest frame's own exposure, plus one decade)\n"
     "  --max-memory SIZE  refuse to render when it needs more than SIZE (e.g. 2G): film,\n"
     "                     sums, buffers and volumes; default 75% of physical memory\n"
     "  --checkpoint       write DIR/checkpoint.bin (DIR = --out) every 60 s, atomically, and\n"
@@ -113,7 +125,8 @@ const char* kRenderHelp =
     "\n"
     "Outputs (see docs/outputs.md): steady.exr, frames/*.exr, peak_time.exr, transient.npy\n"
     "(float32, shape (H, W, T, 3)), before_window.exr, after_window.exr, steady.png,\n"
-    "frames.png and render.json (settings, time axis in ps and OPL mm, timings, counters).\n";
+    "frames.png, peak_time.png (with a colour bar in ps), transient.mp4 (--video) and\n"
+    "render.json (settings, time axis in ps and OPL mm, timings, counters).\n";
 
 }  // namespace
 
@@ -131,6 +144,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   double checkpoint_every = 60;
   std::string resume_dir;
   bool quiet = false;
+  std::string video_flag, tonemap_flag, log_flag;  // the first of each given, for error messages
   uint64_t max_memory = cli::physical_memory_bytes() / 4 * 3;
   while (!args.done()) {
     const std::string a = args.next();
@@ -158,6 +172,31 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       else args.fail("expected files, multipart or none", v);
     } else if (a == "--no-previews") {
       out.previews = false;
+    } else if (a == "--video") {
+      out.video = true;
+    } else if (a == "--video-fps") {
+      out.video_spec.fps = static_cast<int>(args.int_value(1, 240));
+      if (video_flag.empty()) video_flag = a;
+    } else if (a == "--video-encoder") {
+      out.video_spec.encoder = args.value();
+      if (out.video_spec.encoder.empty()) args.fail("expects an FFmpeg encoder name, e.g. libx264", "");
+      if (video_flag.empty()) video_flag = a;
+    } else if (a == "--tonemap") {
+      const std::string v = args.value();
+      if (!parse_tone_map(v, out.tonemap.mode)) args.fail("expected global, per-frame or log", v);
+      if (tonemap_flag.empty()) tonemap_flag = a;
+    } else if (a == "--exposure") {
+      out.tonemap.exposure_stops = args.number_in(-30.0, 30.0, false, false, "in [-30, 30] stops");
+      if (tonemap_flag.empty()) tonemap_flag = a;
+    } else if (a == "--log-decades") {
+      const std::string v = args.value();
+      char* end = nullptr;
+      const double d = std::strtod(v.c_str(), &end);
+      if (v == "auto") out.tonemap.log_decades = 0;
+      else if (v.empty() || *end != '\0' || !(d >= 0.5 && d <= 12)) args.fail("expected 0.5..12 or auto", v);
+      else out.tonemap.log_decades = d;
+      log_flag = a;
+      if (tonemap_flag.empty()) tonemap_flag = a;
     } else if (a == "--max-memory") {
       max_memory = args.size_value();
     } else if (a == "--quiet" || a == "-q") {
@@ -170,6 +209,16 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       args.fail("only one scene file may be given", a);
     }
   }
+
+  // Picture options that would silently do nothing are errors.
+  if (!video_flag.empty() && !out.video)
+    throw InputError("femto render: " + video_flag + ": applies to the video only; add --video");
+  if (!log_flag.empty() && out.tonemap.mode != ToneMapMode::Log)
+    throw InputError("femto render: " + log_flag + ": applies to --tonemap log only");
+  if (!tonemap_flag.empty() && !out.previews && !out.video)
+    throw InputError("femto render: " + tonemap_flag +
+                     ": tone mapping applies to frames.png and transient.mp4, but --no-previews is given "
+                     "without --video");
 
   // Under mpirun (docs/mpi.md) every rank loads and checks the same input; rank 0 reports and
   // writes. Stopping early and checkpoints are for a single process.
@@ -191,7 +240,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     if (tissue::is_tissue_scene(scene_text)) {  // tissue optics (docs/tissue.md)
       const char* camera_only = overrides.camera_only_flag() ? overrides.camera_only_flag()
                               : checkpoint ? "--checkpoint" : !resume_dir.empty() ? "--resume"
-                              : !out.previews ? "--no-previews" : nullptr;
+                              : !out.previews ? "--no-previews" : out.video ? "--video"
+                              : !video_flag.empty() ? video_flag.c_str()
+                              : !tonemap_flag.empty() ? tonemap_flag.c_str() : nullptr;
       if (camera_only)
         throw InputError(std::string("femto render: ") + camera_only + ": does not apply to the tissue scene " +
                          clip(scene_path, 200) + " (its options: --photons, --seed, --threads, --out, "
@@ -259,6 +310,11 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                        ": the checkpoint was made with different settings (" + diff +
                        "); resume with the same scene file and options");
   }
+  // A missing H.264 encoder is found before rendering, not after.
+  if (out.video) out.video_spec.encoder = check_h264_encoder(out.video_spec.encoder, out.video_backend);
+  if (out.video && (cam.width > 16384 || cam.height > 16384))
+    throw InputError("--video: the film is " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
+                     " pixels; the video is limited to 16384 on each side (render without --video)");
   // The output folder is checked before the (possibly long) scene build: a foreign or
   // unwritable --out is bad input.
   {

@@ -13,6 +13,7 @@
 #include "core/io/png.h"
 #include "core/io/sha256.h"
 #include "core/memory_usage.h"
+#include "core/previews.h"
 #include "core/io/tonemap.h"
 
 namespace femto {
@@ -83,32 +84,27 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
                     film.transient());
   files.push_back("transient.npy");
 
+  std::vector<ToneCurve> curves;
+  if (opt.previews || opt.video) {
+    curves = frame_tone_curves(film, opt.tonemap);
+    info["tone_mapping"] = tone_mapping_json(opt.tonemap, curves);
+  }
   if (opt.previews) {
     const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
     const double exposure = auto_exposure(film.steady(), pixels);
     const std::vector<uint8_t> img = tonemap_srgb8(film.steady(), pixels, exposure);
     write_png_rgb8(path_of("steady.png"), W, H, img.data());
     files.push_back("steady.png");
-    // Contact sheet: up to 16 frames evenly over the window, one exposure for all of them.
-    const int n = std::min(T, 16);
-    std::vector<int> idx;
-    std::vector<std::string> labels;
-    std::vector<float> chosen;
-    for (int k = 0; k < n; ++k) {
-      const int t = n == 1 ? 0 : static_cast<int>(std::lround(static_cast<double>(k) * (T - 1) / (n - 1)));
-      idx.push_back(t);
-      char buf[48];
-      std::snprintf(buf, sizeof buf, "t=%.1fps", axis.bin_start_ps(t));
-      labels.emplace_back(buf);
-      const std::vector<float> f = film.frame(t);
-      chosen.insert(chosen.end(), f.begin(), f.end());
-    }
-    const double frame_exposure = auto_exposure(chosen.data(), chosen.size() / 3);
-    int sw = 0, sh = 0;
-    const std::vector<uint8_t> sheet =
-        contact_sheet_rgb8(W, H, T, film.transient(), idx, labels, 4, frame_exposure, sw, sh);
-    write_png_rgb8(path_of("frames.png"), sw, sh, sheet.data());
+    // Contact sheet: up to 16 frames evenly over the window (core/previews.h).
+    write_contact_sheet(path_of("frames.png"), film, opt.tonemap, curves);
     files.push_back("frames.png");
+    info["peak_time_png"] = write_peak_time_png(path_of("peak_time.png"), film);
+    files.push_back("peak_time.png");
+  }
+  if (opt.video) {
+    info["video"] = write_transient_video(path_of("transient.mp4"), film, opt.tonemap, curves, opt.video_spec,
+                                          opt.video_backend);
+    files.push_back("transient.mp4");
   }
   files.push_back("render.json");
   info["outputs"] = files;

@@ -8,6 +8,8 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "core/film.h"
+#include "core/io/tone_mapping.h"
+#include "core/io/video.h"
 
 namespace femto {
 
@@ -15,7 +17,11 @@ struct OutputOptions {
   enum class Frames { Files, Multipart, None };
   std::string dir = "femto-out";
   Frames frames = Frames::Files;
-  bool previews = true;  ///< steady.png and frames.png
+  bool previews = true;  ///< steady.png, frames.png and peak_time.png
+  ToneMapSettings tonemap;  ///< of frames.png and transient.mp4
+  bool video = false;       ///< transient.mp4
+  VideoSpec video_spec;     ///< fps and encoder (the size is the film's, enlarged)
+  VideoBackend video_backend = default_video_backend();
 };
 
 /// File name of frame t inside the output folder, e.g. "frames/frame_0007_12.500ps.exr".

@@ -216,7 +216,7 @@ TEST_CASE("cli: a rerun replaces the whole output folder; render.json lists ever
   write_file(tmp.dir / "a.json", scene_text(16, 12, 40));
   write_file(tmp.dir / "b.json", scene_text(16, 12, 4));
   REQUIRE(run_femto({"render", "a.json", "--spp", "1", "--out", "out", "--quiet"}, tmp.dir).code == 0);
-  CHECK(tree(tmp.dir / "out").size() == 40 + 8);
+  CHECK(tree(tmp.dir / "out").size() == 40 + 9);  // frames + 9 other files (peak_time.png included)
   const auto r = run_femto({"render", "b.json", "--spp", "1", "--out", "out", "--quiet"}, tmp.dir);
   REQUIRE(r.code == 0);
   const json info = read_json(tmp.dir / "out" / "render.json");
@@ -230,7 +230,7 @@ TEST_CASE("cli: a rerun replaces the whole output folder; render.json lists ever
     CHECK(f["sha256"] == sha256_file((tmp.dir / "out" / name).string()));
   }
   CHECK(tree(tmp.dir / "out") == listed);  // exactly the new files: 4 frames, not 40
-  CHECK(listed.size() == 4 + 8);
+  CHECK(listed.size() == 4 + 9);
   check_no_temporaries(tmp.dir);
 }
 
