@@ -21,6 +21,7 @@ const char* kInfoHelp =
     "and, for each medium, its type and coefficients. For a \"vdb\" medium also: file, grids\n"
     "used, world bounding box, voxel size, dense resolution, active voxels, value ranges\n"
     "(density, sigma_t = sigma_t_scale * density, albedo, eta) and the memory of the dense grids.\n"
+    "A .xml scene is read as Mitsuba 3 / mitransient XML (a subset, docs/mitsuba.md).\n"
     "Exit code 2 with a one-line message naming the file, key and value on bad input.\n"
     "\n"
     "Options:\n"
@@ -112,6 +113,7 @@ int cmd_info(const std::vector<std::string>& argv, const std::string&) {
   }
   if (path.empty()) throw InputError("femto info: missing SCENE.json (see femto info --help)");
   const SceneDesc s = load_scene_file(path);
+  for (const std::string& w : s.warnings) std::fprintf(stderr, "femto: warning: %s\n", w.c_str());
   // Every volume is loaded (and validated) before anything is printed.
   std::vector<VolumeData> volumes(s.media.size());
   for (size_t i = 0; i < s.media.size(); ++i)

@@ -17,6 +17,7 @@
 #include "apps/stop_signals.h"
 #include "core/checkpoint.h"
 #include "core/io/sha256.h"
+#include "core/mitsuba/mitsuba_xml.h"
 #include "core/memory_usage.h"
 #include "core/output_folder.h"
 #include "apps/render_record.h"
@@ -37,7 +38,8 @@ const char* kRenderHelp =
     "Usage: femto render [SCENE.json] [options]\n"
     "\n"
     "Renders a time-resolved image (H x W x T) of SCENE.json, or of the built-in default scene\n"
-    "(a pulsed spot light in fog behind a glass sphere) when no scene is given.\n"
+    "(a pulsed spot light in fog behind a glass sphere) when no scene is given. A .xml scene is\n"
+    "read as Mitsuba 3 / mitransient XML (a subset, docs/mitsuba.md).\n"
     "\n"
     "Options (override the scene's \"render\" block):\n"
     "  --spp N            samples (camera paths) per pixel, 1..10^7 (scene default: 16)\n"
@@ -282,9 +284,16 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       t.max_memory = max_memory;
       return run_tissue_scene(scene_text, scene_path, t, command_line);
     }
-    desc = load_scene_string(scene_text, scene_path,
-                             std::filesystem::path(scene_path).parent_path().string());
+    const std::string base_dir = std::filesystem::path(scene_path).parent_path().string();
+    if (is_mitsuba_xml_path(scene_path)) {
+      MitsubaImport xml = load_mitsuba_xml(scene_text, scene_path, base_dir);
+      scene_text = std::move(xml.femto_json);  // render.json records the translated scene
+      desc = std::move(xml.desc);
+    } else {
+      desc = load_scene_string(scene_text, scene_path, base_dir);
+    }
   }
+  for (const std::string& w : desc.warnings) std::fprintf(stderr, "femto: warning: %s\n", w.c_str());
   for (MediumDesc& m : desc.media) {
     if (sampling) m.sampling = *sampling;
     if (connection) m.connection = *connection;
