@@ -217,6 +217,9 @@ TEST_CASE("mitsuba xml: rough dielectric, named ior, placed lights, flip_normals
   CHECK(d.lights[1].direction.y == Approx(-1.0).epsilon(1e-12));
   CHECK(d.lights[1].cone_angle_deg == 40.0);
   CHECK(d.lights[2].position.z == 3.0);
+  // A <lookat> without 'up' takes Mitsuba's generated perpendicular: +x when looking down -z.
+  CHECK(d.camera.up.x == 1.0);
+  CHECK(d.camera.up.y == 0.0);
 }
 
 // Catches: elements outside the subset silently ignored, and messages that do not locate the
@@ -281,6 +284,10 @@ TEST_CASE("mitsuba xml: bad input names the file, line and element", "[mitsuba]"
              Contains("bad.xml:2: <bogus>: unsupported element <bogus> at the scene level"));
   CHECK_THAT(error_of("<scene>\n</scene>\n"),
              Contains("bad.xml:1: <scene>: the scene has no <sensor>"));
+  std::string dark = xml_scene("");
+  const std::size_t e0 = dark.find("  <emitter"), e1 = dark.find("</emitter>\n") + 11;
+  dark.erase(e0, e1 - e0);
+  CHECK_THAT(error_of(dark), Contains("bad.xml:1: <scene>: the scene has no emitter"));
   std::string steady = xml_scene("");
   steady.replace(steady.find("transient_hdr_film"), 18, "hdrfilm");
   CHECK_THAT(error_of(steady),

@@ -96,6 +96,14 @@ struct Affine {
   }
 };
 
+/// The first tangent of Mitsuba's coordinate_system(n) (Duff et al. 2017), which a <lookat>
+/// without 'up' uses as its up direction.
+inline Vec3 any_perpendicular(const Vec3& n) {
+  const double sign = std::copysign(1.0, n.z);
+  const double a = -1.0 / (sign + n.z), b = n.x * n.y * a;
+  return {1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x};
+}
+
 /// femto's shape transform: p -> Rz Ry Rx (scale * p) + translate (docs/scene-format.md).
 struct SplitTransform {
   Vec3 scale{1, 1, 1};

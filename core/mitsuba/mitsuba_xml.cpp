@@ -27,7 +27,7 @@ const char* const kUnitDefault = "femto_unit_mm";
 
 std::string fmt(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
+  std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
 }
 
@@ -152,6 +152,11 @@ class Importer {
         fail(c, "unsupported element <" + clip(tag) + "> at the scene level");
       }
     }
+    const bool emissive = std::any_of(out_["shapes"].begin(), out_["shapes"].end(),
+                                      [](const Json& sh) { return sh.contains("emission"); });
+    if (out_["lights"].empty() && !emissive)
+      fail(scene,
+           "the scene has no emitter (a point or spot emitter, or an area emitter in a shape)");
     if (!media_.empty()) {
       Json media = Json::object();
       for (const auto& m : media_) media[m.name] = m.json;
@@ -524,7 +529,9 @@ class Importer {
         } else if (op == "lookat") {
           check_attributes(c, {"origin", "target", "up"});
           const Vec3 o = triple(c, "origin"), t = triple(c, "target");
-          const Vec3 up = c.attribute("up") ? triple(c, "up") : Vec3(0, 1, 0);
+          Vec3 up = c.attribute("up") ? triple(c, "up") : Vec3(0, 0, 0);
+          if (up.x == 0 && up.y == 0 && up.z == 0 && length(t - o) > 0)
+            up = mitsuba::any_perpendicular(normalize(t - o));  // what Mitsuba does
           if (!(length(t - o) > 0)) fail(c, "'target' must differ from 'origin'");
           if (!(length(cross(normalize(up), normalize(t - o))) > 1e-9))
             fail(c, "'up' must be non-zero and not parallel to target - origin");
