@@ -102,6 +102,8 @@ const char* kRenderHelp =
     "                     any --threads): the result has the same bits as an uninterrupted\n"
     "                     run; writes to DIR unless --out is given; keeps checkpointing\n"
     "  --quiet            no progress or summary on stderr\n"
+    "  -D NAME=VALUE      Mitsuba XML scenes: the value of $NAME, over the file's <default>\n"
+    "                     (repeatable; e.g. -D spp=64 -D femto_unit_mm=1000)\n"
     "  --help             this help\n"
     "\n"
     "Ctrl-C or SIGTERM: the current pass is finished and a complete result for the samples\n"
@@ -121,6 +123,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   stop_signals::start();
   cli::Args args("femto render", argv);
   std::string scene_path;
+  XmlDefines xml_defines;  // -D NAME=VALUE for Mitsuba XML scenes
   std::optional<int> spp, max_depth;
   std::optional<uint64_t> seed;
   std::optional<DistanceSampling> sampling;
@@ -246,6 +249,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       max_memory = args.size_value();
     } else if (a == "--quiet" || a == "-q") {
       quiet = true;
+    } else if (a == "-D" || a == "--define") {
+      const std::string d = args.value();
+      if (!add_xml_define(d, xml_defines)) args.fail("expects NAME=VALUE", d);
     } else if (!a.empty() && a[0] == '-') {
       args.fail("unknown option (see femto render --help)", a);
     } else if (scene_path.empty()) {
@@ -255,6 +261,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     }
   }
 
+  if (!xml_defines.empty() && !is_mitsuba_xml_path(scene_path))
+    throw InputError("femto render: -D " + clip(xml_defines.begin()->first) +
+                     ": applies to Mitsuba XML scenes (.xml) only");
   // Load and validate everything before anything is written.
   std::string scene_text;
   SceneDesc desc;
@@ -286,7 +295,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     }
     const std::string base_dir = std::filesystem::path(scene_path).parent_path().string();
     if (is_mitsuba_xml_path(scene_path)) {
-      MitsubaImport xml = load_mitsuba_xml(scene_text, scene_path, base_dir);
+      MitsubaImport xml = load_mitsuba_xml(scene_text, scene_path, base_dir, xml_defines);
       scene_text = std::move(xml.femto_json);  // render.json records the translated scene
       desc = std::move(xml.desc);
     } else {

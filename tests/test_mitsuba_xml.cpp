@@ -406,6 +406,17 @@ TEST_CASE("mitsuba xml: femto render and femto info on XML scenes", "[mitsuba][c
   CHECK(fs::exists(tmp.dir / "out" / "render.json"));
   CHECK_THAT(test::read_file(tmp.dir / "out" / "render.json"), Contains("\"bin_width_opl\""));
 
+  // -D NAME=VALUE sets $NAME over the file's <default> (the twin's film width is $width).
+  const test::Run wide =
+      test::run_femto({"info", (kData / "twin.xml").string(), "-D", "width=20"}, tmp.dir);
+  CHECK(wide.code == 0);
+  CHECK_THAT(wide.out, Contains("20 x 12 pixels"));
+  CHECK(test::run_femto({"info", (kData / "twin.xml").string(), "-D", "width"}, tmp.dir).code == 2);
+  const test::Run json_d = test::run_femto(
+      {"render", FEMTO_SOURCE_DIR "/data/scenes/default.json", "-D", "spp=1"}, tmp.dir);
+  CHECK(json_d.code == 2);
+  CHECK_THAT(json_d.err, Contains("-D spp: applies to Mitsuba XML scenes (.xml) only"));
+
   test::write_file(tmp.dir / "bad.xml", xml_scene("  <shape type=\"torus\"/>\n"));
   const test::Run bad = test::run_femto(
       {"render", (tmp.dir / "bad.xml").string(), "--out", (tmp.dir / "bad_out").string()}, tmp.dir);

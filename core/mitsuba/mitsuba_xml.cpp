@@ -69,8 +69,9 @@ struct Props {
 
 class Importer {
  public:
-  Importer(const std::string& text, std::string source, std::string base_dir)
-      : text_(text), source_(std::move(source)), base_dir_(std::move(base_dir)) {
+  Importer(const std::string& text, std::string source, std::string base_dir,
+           const XmlDefines& defines)
+      : text_(text), source_(std::move(source)), base_dir_(std::move(base_dir)), defines_(defines) {
     line_starts_.push_back(0);
     for (std::size_t i = 0; i < text_.size(); ++i)
       if (text_[i] == '\n') line_starts_.push_back(i + 1);
@@ -100,12 +101,21 @@ class Importer {
         defaults_[name] = raw_attr(c, "value");
       }
     }
+    for (const auto& [name, value] : defines_) defaults_[name] = value;
     if (defaults_.count(kUnitDefault)) {
       const Node d = scene.find_child_by_attribute("default", "name", kUnitDefault);
-      unit_mm_ = number(d, "value", attr(d, "value"));
+      const std::string v = defaults_.at(kUnitDefault);
+      if (defines_.count(kUnitDefault)) {
+        if (!parse_number(v, unit_mm_))
+          throw InputError(clip(source_, 200) + ": -D femto_unit_mm: expected a number (got \"" +
+                           clip(v) + "\")");
+      } else {
+        unit_mm_ = number(d, "value", v);
+      }
       if (!(unit_mm_ >= 1e-6 && unit_mm_ <= 1e9))
-        fail(d, "femto_unit_mm must be in [1e-6, 1e9] mm per scene unit (got " +
-                    clip(attr(d, "value")) + ")");
+        throw InputError(
+            (defines_.count(kUnitDefault) ? clip(source_, 200) + ": -D femto_unit_mm" : where(d)) +
+            ": femto_unit_mm must be in [1e-6, 1e9] mm per scene unit (got " + clip(v) + ")");
     }
     for (Node c : scene.children()) {
       if (c.type() != pugi::node_element || std::string(c.name()) == "default") continue;
@@ -185,6 +195,7 @@ class Importer {
   std::string source_, base_dir_;
   std::vector<std::size_t> line_starts_;
   std::map<std::string, std::string> defaults_;
+  XmlDefines defines_;  // from the command line; override defaults_
   std::map<std::string, Node> ids_;
   double unit_mm_ = 1.0;
   Json out_;
@@ -295,7 +306,8 @@ class Importer {
       const auto it = defaults_.find(var);
       if (it == defaults_.end())
         fail(n, std::string("attribute '") + name + "': undefined variable $" + clip(var) +
-                    " (no <default name=\"" + clip(var) + "\" .../>)");
+                    " (no <default name=\"" + clip(var) + "\" .../>, nor -D " + clip(var) +
+                    "=...)");
       out += it->second;
       i = j - 1;
     }
@@ -304,14 +316,18 @@ class Importer {
 
   // ---- values
 
-  double number(Node n, const char* what, const std::string& s) const {
+  static bool parse_number(const std::string& s, double& v) {
     std::string t = s;
     t.erase(0, t.find_first_not_of(" \t\r\n"));
     t.erase(t.find_last_not_of(" \t\r\n") + 1);
     if (!t.empty() && t[0] == '+') t.erase(0, 1);
-    double v = 0;
     const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (t.empty() || r.ec != std::errc() || r.ptr != t.data() + t.size() || !std::isfinite(v))
+    return !t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size() && std::isfinite(v);
+  }
+
+  double number(Node n, const char* what, const std::string& s) const {
+    double v = 0;
+    if (!parse_number(s, v))
       fail(n, std::string("attribute '") + what + "': expected a finite number (got \"" + clip(s) +
                   "\")");
     return v;
@@ -1248,8 +1264,15 @@ bool is_mitsuba_xml_path(const std::string& path) {
 }
 
 MitsubaImport load_mitsuba_xml(const std::string& xml_text, const std::string& source,
-                               const std::string& base_dir) {
-  return Importer(xml_text, source, base_dir).run();
+                               const std::string& base_dir, const XmlDefines& defines) {
+  return Importer(xml_text, source, base_dir, defines).run();
+}
+
+bool add_xml_define(const std::string& text, XmlDefines& defines) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) return false;
+  defines[text.substr(0, eq)] = text.substr(eq + 1);
+  return true;
 }
 
 }  // namespace femto
