@@ -473,6 +473,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   info["date_utc"] = cli::utc_now();
   info["scene"] = {{"source", scene.desc().source},
                    {"json", scene_json(scene_text)}};
+  if (!scene.desc().warnings.empty()) info["scene"]["warnings"] = scene.desc().warnings;
   info["settings"] = {{"spp", opt.spp},
                       {"seed", opt.seed},
                       {"threads", result.threads},

@@ -404,7 +404,10 @@ TEST_CASE("mitsuba xml: femto render and femto info on XML scenes", "[mitsuba][c
                                        tmp.dir);
   CHECK(ok.code == 0);
   CHECK(fs::exists(tmp.dir / "out" / "render.json"));
-  CHECK_THAT(test::read_file(tmp.dir / "out" / "render.json"), Contains("\"bin_width_opl\""));
+  // render.json records the translated femto scene and the warnings.
+  const std::string record = test::read_file(tmp.dir / "out" / "render.json");
+  CHECK_THAT(record, Contains("\"bin_width_opl\": 16") && Contains("\"warnings\"") &&
+                         Contains("rr_depth"));
 
   // -D NAME=VALUE sets $NAME over the file's <default> (the twin's film width is $width).
   const test::Run wide =
