@@ -28,6 +28,7 @@ const char* kInfoHelp =
     "\n"
     "Options:\n"
     "  -D NAME=VALUE   Mitsuba XML scenes: the value of $NAME, over the file's <default>\n"
+    "                  (repeatable; also --define NAME=VALUE)\n"
     "  --help          this help\n";
 
 std::string g6(double v) {

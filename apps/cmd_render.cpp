@@ -103,7 +103,7 @@ const char* kRenderHelp =
     "                     run; writes to DIR unless --out is given; keeps checkpointing\n"
     "  --quiet            no progress or summary on stderr\n"
     "  -D NAME=VALUE      Mitsuba XML scenes: the value of $NAME, over the file's <default>\n"
-    "                     (repeatable; e.g. -D spp=64 -D femto_unit_mm=1000)\n"
+    "                     (repeatable; also --define NAME=VALUE; e.g. -D spp=64)\n"
     "  --help             this help\n"
     "\n"
     "Ctrl-C or SIGTERM: the current pass is finished and a complete result for the samples\n"
