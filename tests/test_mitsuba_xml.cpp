@@ -298,6 +298,12 @@ TEST_CASE("mitsuba xml: bad input names the file, line and element", "[mitsuba]"
                                 "value=\"1\"/></integrator>\n")),
              Contains("bad.xml:11: <integer name=\"max_depth\">: max_depth must be -1 (no bound) "
                       "or in [2, 1000001]"));
+  // Names become JSON strings: bytes that are not UTF-8 are refused (a fuzzer finding).
+  CHECK_THAT(error_of("<scene>\n  <shape id=\"a\xff\"/>\n</scene>\n"),
+             Contains("bad.xml:2: the file is not valid UTF-8"));
+  CHECK_THAT(error_of(xml_scene(
+                 "  <shape type=\"obj\"><string name=\"filename\" value=\"\xc3\"/></shape>\n")),
+             Contains("bad.xml:11: the file is not valid UTF-8"));
   // The error type is InputError (exit code 2 in the CLI).
   CHECK_THROWS_AS(load_mitsuba_xml(xml_scene("  <shape type=\"torus\"/>\n"), "bad.xml", "."),
                   InputError);
@@ -406,8 +412,8 @@ TEST_CASE("mitsuba xml: femto render and femto info on XML scenes", "[mitsuba][c
   CHECK(fs::exists(tmp.dir / "out" / "render.json"));
   // render.json records the translated femto scene and the warnings.
   const std::string record = test::read_file(tmp.dir / "out" / "render.json");
-  CHECK_THAT(record, Contains("\"bin_width_opl\": 16") && Contains("\"warnings\"") &&
-                         Contains("rr_depth"));
+  CHECK_THAT(record,
+             Contains("\"bin_width_opl\": 16") && Contains("\"warnings\"") && Contains("rr_depth"));
 
   // -D NAME=VALUE sets $NAME over the file's <default> (the twin's film width is $width).
   const test::Run wide =

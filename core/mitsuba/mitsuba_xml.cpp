@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -52,6 +53,38 @@ bool named_ior(const std::string& name, double& eta) {
   return true;
 }
 
+// Offset of the first byte that breaks UTF-8 (overlong forms, surrogates and values above
+// U+10FFFF included), or npos.
+std::size_t invalid_utf8(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    std::uint32_t cp = 0, min = 0;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      n = 1, cp = c & 0x1Fu, min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      n = 2, cp = c & 0x0Fu, min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      n = 3, cp = c & 0x07u, min = 0x10000;
+    } else {
+      return i;
+    }
+    if (i + n >= s.size()) return i;  // truncated sequence
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto cc = static_cast<unsigned char>(s[i + k]);
+      if ((cc & 0xC0) != 0x80) return i;
+      cp = (cp << 6) | (cc & 0x3Fu);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
+    i += n + 1;
+  }
+  return std::string::npos;
+}
+
 const std::set<std::string> kPropertyTags = {"float",    "integer", "boolean", "string",   "rgb",
                                              "spectrum", "point",   "vector",  "transform"};
 const std::set<std::string> kObjectTags = {"bsdf",       "emitter", "medium", "phase",  "film",
@@ -78,6 +111,11 @@ class Importer {
   }
 
   MitsubaImport run() {
+    // Names and values end up in JSON strings, which must be UTF-8.
+    if (const std::size_t bad = invalid_utf8(text_); bad != std::string::npos)
+      throw InputError(clip(source_, 200) + ":" +
+                       std::to_string(line_of(static_cast<std::ptrdiff_t>(bad))) +
+                       ": the file is not valid UTF-8 (byte " + std::to_string(bad) + ")");
     pugi::xml_document doc;
     const pugi::xml_parse_result parsed =
         doc.load_buffer(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
