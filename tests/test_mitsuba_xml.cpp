@@ -287,6 +287,22 @@ TEST_CASE("mitsuba xml: rough dielectric, named ior, placed lights, flip_normals
   CHECK(d.camera.up.y == 0.0);
 }
 
+// Catches: a constant emitter changing the scene (mitransient puts its light at infinite path
+// length, outside every bin), or not being reported.
+TEST_CASE("mitsuba xml: a constant emitter is left out with a warning", "[mitsuba]") {
+  const SceneDesc with =
+      load_mitsuba_xml(
+          xml_scene(
+              "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.5\"/></emitter>\n"),
+          "c.xml", ".")
+          .desc;
+  const SceneDesc without = load_mitsuba_xml(xml_scene(""), "c.xml", ".").desc;
+  CHECK(with.lights.size() == without.lights.size());
+  CHECK(with.shapes.size() == without.shapes.size());
+  REQUIRE(with.warnings.size() == 1);
+  CHECK_THAT(with.warnings[0], Contains("c.xml:11: <emitter type=\"constant\">: left out"));
+}
+
 // Catches: elements outside the subset silently ignored, and messages that do not locate the
 // problem (file, line, element, attribute or value).
 TEST_CASE("mitsuba xml: bad input names the file, line and element", "[mitsuba]") {
@@ -314,8 +330,8 @@ TEST_CASE("mitsuba xml: bad input names the file, line and element", "[mitsuba]"
   CHECK_THAT(body_error("  <shape type=\"sphere\"><float name=\"radiuss\" value=\"1\"/></shape>\n"),
              Contains("bad.xml:11: <float name=\"radiuss\">: property 'radiuss' is not supported "
                       "for <shape type=\"sphere\">"));
-  CHECK_THAT(body_error("  <emitter type=\"constant\"/>\n"),
-             Contains("bad.xml:11: <emitter type=\"constant\">: unsupported emitter"));
+  CHECK_THAT(body_error("  <emitter type=\"envmap\"/>\n"),
+             Contains("bad.xml:11: <emitter type=\"envmap\">: unsupported emitter"));
   CHECK_THAT(
       body_error("  <texture type=\"bitmap\" id=\"t\"/>\n"),
       Contains("bad.xml:11: <texture type=\"bitmap\" id=\"t\">: textures are not supported"));
@@ -353,6 +369,9 @@ TEST_CASE("mitsuba xml: bad input names the file, line and element", "[mitsuba]"
   const std::size_t e0 = dark.find("  <emitter"), e1 = dark.find("</emitter>\n") + 11;
   dark.erase(e0, e1 - e0);
   CHECK_THAT(error_of(dark), Contains("bad.xml:1: <scene>: the scene has no emitter"));
+  // A constant emitter alone: left out (infinite arrival time), so there is no light.
+  dark.insert(dark.find("</scene>"), "  <emitter type=\"constant\"/>\n");
+  CHECK_THAT(error_of(dark), Contains("a constant emitter adds nothing to the time bins"));
   std::string steady = xml_scene("");
   steady.replace(steady.find("transient_hdr_film"), 18, "hdrfilm");
   CHECK_THAT(error_of(steady),

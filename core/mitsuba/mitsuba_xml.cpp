@@ -204,7 +204,9 @@ class Importer {
                                       [](const Json& sh) { return sh.contains("emission"); });
     if (out_["lights"].empty() && !emissive)
       fail(scene,
-           "the scene has no emitter (a point or spot emitter, or an area emitter in a shape)");
+           std::string("the scene has no emitter (a point or spot emitter, or an area emitter "
+                       "in a shape)") +
+               (infinite_emitters_ ? "; a constant emitter adds nothing to the time bins" : ""));
     if (!media_.empty()) {
       Json media = Json::object();
       for (const auto& m : media_) media[m.name] = m.json;
@@ -246,7 +248,8 @@ class Importer {
     Json json;
   };
   std::vector<Medium> media_;
-  Node global_medium_;  // the sensor's medium, or none (vacuum)
+  Node global_medium_;              // the sensor's medium, or none (vacuum)
+  bool infinite_emitters_ = false;  // constant emitters, left out
 
   // ---- messages
 
@@ -1240,10 +1243,24 @@ class Importer {
     const std::string path = "/lights/" + std::to_string(out_["lights"].size());
     origin(path, n);
     if (type == "area") fail(n, "an area emitter belongs inside a <shape>");
-    if (type == "constant" || type == "envmap" || type == "directional")
+    if (type == "constant") {
+      // mitransient stamps light from infinity with an infinite path length (the escaped ray's
+      // distance), so it never lands in a time bin: leaving it out keeps the transient the same.
+      Props p = props(n);
+      const RGB L = get_rgb(p, "radiance", RGB(1.0));
+      (void)L;
+      check_all_used(p);
+      if (!p.objects.empty()) fail(p.objects.front(), "unexpected element inside <emitter>");
+      warn(n,
+           "left out: its light arrives at infinite path length, after every time bin, as in "
+           "mitransient's transient film (docs/mitsuba.md)");
+      infinite_emitters_ = true;
+      return;
+    }
+    if (type == "envmap" || type == "directional")
       fail(n, "unsupported emitter \"" + type +
                   "\": femto has no light at infinity (point, spot and "
-                  "area emitters are)");
+                  "area emitters are; constant is accepted and left out)");
     if (type != "point" && type != "spot")
       fail(n, "unsupported emitter \"" + clip(type) + "\" (point, spot and area are)");
     Props p = props(n);
