@@ -18,6 +18,7 @@
 #include "core/checkpoint.h"
 #include "core/distributed/comm.h"
 #include "core/io/sha256.h"
+#include "core/mitsuba/mitsuba_xml.h"
 #include "core/memory_usage.h"
 #include "core/output_folder.h"
 #include "apps/render_flags.h"
@@ -39,7 +40,8 @@ const char* kRenderHelp =
     "Usage: femto render [SCENE.json] [options]\n"
     "\n"
     "Renders a time-resolved image (H x W x T) of SCENE.json, or of the built-in default scene\n"
-    "(a pulsed spot light in fog behind a glass sphere) when no scene is given.\n"
+    "(a pulsed spot light in fog behind a glass sphere) when no scene is given. A .xml scene is\n"
+    "read as Mitsuba 3 / mitransient XML (a subset, docs/mitsuba.md).\n"
     "\n"
     "Options (override the scene's \"render\" block):\n"
     "  --spp N            samples (camera paths) per pixel, 1..10^7 (scene default: 16)\n"
@@ -114,6 +116,8 @@ const char* kRenderHelp =
     "                     any --threads): the result has the same bits as an uninterrupted\n"
     "                     run; writes to DIR unless --out is given; keeps checkpointing\n"
     "  --quiet            no progress or summary on stderr\n"
+    "  -D NAME=VALUE      Mitsuba XML scenes: the value of $NAME, over the file's <default>\n"
+    "                     (repeatable; also --define NAME=VALUE; e.g. -D spp=64)\n"
     "  --help             this help\n"
     "\n"
     "Ctrl-C or SIGTERM: the current pass is finished and a complete result for the samples\n"
@@ -137,6 +141,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   stop_signals::start();
   cli::Args args("femto render", argv);
   std::string scene_path;
+  XmlDefines xml_defines;  // -D NAME=VALUE for Mitsuba XML scenes
   RenderOverrides overrides;
   OutputOptions out;
   bool out_given = false;
@@ -201,6 +206,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       max_memory = args.size_value();
     } else if (a == "--quiet" || a == "-q") {
       quiet = true;
+    } else if (a == "-D" || a == "--define") {
+      const std::string d = args.value();
+      if (!add_xml_define(d, xml_defines)) args.fail("expects NAME=VALUE", d);
     } else if (!a.empty() && a[0] == '-') {
       args.fail("unknown option (see femto render --help)", a);
     } else if (scene_path.empty()) {
@@ -210,6 +218,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
     }
   }
 
+  if (!xml_defines.empty() && !is_mitsuba_xml_path(scene_path))
+    throw InputError("femto render: -D " + clip(xml_defines.begin()->first) +
+                     ": applies to Mitsuba XML scenes (.xml) only");
   // Picture options that would silently do nothing are errors.
   if (!video_flag.empty() && !out.video)
     throw InputError("femto render: " + video_flag + ": applies to the video only; add --video");
@@ -256,9 +267,16 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       t.max_memory = max_memory;
       return run_tissue_scene(scene_text, scene_path, t, command_line);
     }
-    desc = load_scene_string(scene_text, scene_path,
-                             std::filesystem::path(scene_path).parent_path().string());
+    const std::string base_dir = std::filesystem::path(scene_path).parent_path().string();
+    if (is_mitsuba_xml_path(scene_path)) {
+      MitsubaImport xml = load_mitsuba_xml(scene_text, scene_path, base_dir, xml_defines);
+      scene_text = std::move(xml.femto_json);  // render.json records the translated scene
+      desc = std::move(xml.desc);
+    } else {
+      desc = load_scene_string(scene_text, scene_path, base_dir);
+    }
   }
+  for (const std::string& w : desc.warnings) std::fprintf(stderr, "femto: warning: %s\n", w.c_str());
   const std::string where = scene_path.empty() ? "femto render" : scene_path;
   RenderSetup setup = apply_render_overrides(desc, overrides, args.command(), where);
   const IntegratorKind kind = setup.kind;

@@ -187,6 +187,7 @@ nlohmann::json render_info(const Scene& scene, const std::string& scene_text, co
   info["femto_build"] = FEMTO_GIT_DESCRIBE;
   info["scene"] = {{"source", scene.desc().source},
                    {"json", scene_json(scene_text)}};
+  if (!scene.desc().warnings.empty()) info["scene"]["warnings"] = scene.desc().warnings;
   info["settings"] = {{"spp", opt.spp},
                       {"seed", opt.seed},
                       {"threads", result.threads},

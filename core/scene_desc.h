@@ -192,6 +192,7 @@ struct SceneDesc {
   std::vector<ShapeDesc> shapes;
   std::vector<LightDesc> lights;
   IntegratorDesc integrator;
+  std::vector<std::string> warnings;  ///< imported settings accepted but not used (Mitsuba XML)
 };
 
 }  // namespace femto

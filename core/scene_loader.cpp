@@ -15,7 +15,9 @@
 
 #include "core/constants.h"
 #include "core/error.h"
+#include "core/io/ply.h"
 #include "core/medium_nesting.h"
+#include "core/mitsuba/mitsuba_xml.h"
 #include "core/obj_loader.h"
 
 namespace femto {
@@ -914,12 +916,15 @@ class Loader {
       const std::string fp = at(p, "file");
       const Json& jf = require(o, p, "file");
       const std::string file = string(jf, fp);
-      if (file.empty()) fail(fp, "must name an OBJ file", jf);
+      if (file.empty()) fail(fp, "must name an OBJ or PLY file", jf);
       const std::string path = resolve(file);
       std::error_code ec;
       if (!fs::is_regular_file(path, ec)) fail(fp, "mesh file not found: " + clip(path, 200), jf);
       try {
-        load_obj(path, s.vertices, s.triangles);
+        if (fs::path(path).extension() == ".ply")
+          load_ply(path, s.vertices, s.triangles);
+        else
+          load_obj(path, s.vertices, s.triangles);
       } catch (const InputError& e) {
         fail(fp, e.what());
       }
@@ -1120,7 +1125,9 @@ std::string read_scene_text(const std::string& path) {
 }
 
 SceneDesc load_scene_file(const std::string& path) {
-  return load_scene_string(read_scene_text(path), path, fs::path(path).parent_path().string());
+  const std::string base_dir = fs::path(path).parent_path().string();
+  if (is_mitsuba_xml_path(path)) return load_mitsuba_xml(read_scene_text(path), path, base_dir).desc;
+  return load_scene_string(read_scene_text(path), path, base_dir);
 }
 
 }  // namespace femto

@@ -7,6 +7,7 @@
 namespace femto {
 
 /// Reads and validates a scene file; relative mesh paths resolve against the file's folder.
+/// A .xml file is read as a Mitsuba 3 scene (core/mitsuba/mitsuba_xml.h, docs/mitsuba.md).
 /// Throws InputError with a one-line message "<file>: <json path>: <problem> (got <value>)".
 SceneDesc load_scene_file(const std::string& path);
 

@@ -16,7 +16,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 jobs="${FEMTO_JOBS:-$(nproc 2>/dev/null || echo 2)}"
 
 packages=(cmake g++ ninja-build libopenvdb-dev libembree-dev libtbb-dev libopenexr-dev catch2
-          libboost-iostreams-dev nlohmann-json3-dev libpng-dev python3-numpy
+          libboost-iostreams-dev nlohmann-json3-dev libpng-dev python3-numpy libpugixml-dev
           libopenmpi-dev openmpi-bin pybind11-dev python3-dev python3-pytest python3-matplotlib
           pkg-config libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg)
 # The sanitizer build and the fuzz targets (scripts/fuzz.sh): clang, its sanitizer and libFuzzer
