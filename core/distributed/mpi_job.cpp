@@ -48,6 +48,22 @@ class MpiComm final : public Comm {
     }
   }
 
+  void all_gather(const std::vector<char>& mine, const Fold& fold) const override {
+    if (size_ <= 1) return fold(0, mine);
+    std::vector<char> theirs;
+    for (int r = 0; r < size_; ++r) {  // rank r broadcasts its bytes, in pieces
+      const bool me = r == rank_;
+      uint64_t n = me ? mine.size() : 0;
+      MPI_Bcast(&n, 1, MPI_UINT64_T, r, MPI_COMM_WORLD);
+      if (!me) theirs.resize(static_cast<size_t>(n));
+      char* data = me ? const_cast<char*>(mine.data()) : theirs.data();
+      for (size_t at = 0; at < n; at += kPiece)
+        MPI_Bcast(data + at, static_cast<int>(std::min<size_t>(kPiece, n - at)), MPI_BYTE, r,
+                  MPI_COMM_WORLD);
+      fold(r, me ? mine : theirs);
+    }
+  }
+
   void sum_to_root(std::vector<uint64_t>& values) const override {
     if (size_ <= 1) return;
     constexpr size_t piece = kPiece / sizeof(uint64_t);
