@@ -1,5 +1,5 @@
-// The job under MPI (FEMTO_MPI): MPI_COMM_WORLD, with only the thread that called start() making
-// MPI calls (MPI_THREAD_FUNNELED; oneTBB workers never do).
+// The job under MPI (FEMTO_MPI): MPI_COMM_WORLD. MPI calls come from one thread at a time
+// (MPI_THREAD_SERIALIZED): the command's thread, which oneTBB may run inside a task arena.
 #include <mpi.h>
 
 #include <algorithm>
@@ -102,9 +102,15 @@ bool launched_by_mpi() {
 void start(int& argc, char**& argv) {
   if (!launched_by_mpi() || g_joined) return;
   int provided = 0;
-  if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
+  if (MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS) {
     std::fprintf(stderr, "femto: failure: MPI_Init_thread failed\n");
     std::exit(1);
+  }
+  if (provided < MPI_THREAD_SERIALIZED) {
+    std::fprintf(stderr,
+                 "femto: failure: this MPI library does not allow calls from threads "
+                 "(MPI_THREAD_SERIALIZED)\n");
+    MPI_Abort(MPI_COMM_WORLD, 1);
   }
   // Errors in MPI calls end the job (the default handler), with MPI's own message.
   int rank = 0, size = 1;
