@@ -64,6 +64,16 @@ int main(int argc, char** argv) {
   args.erase(args.begin());
   for (const auto& c : femto::commands()) {
     if (name != c.name) continue;
+    // Only these split their work over ranks; N copies of another command would repeat it.
+    const bool distributed = name == "render" || name == "tissue" || name == "diffusion";
+    if (!distributed && !femto::distributed::world().single()) {
+      if (femto::distributed::world().root())
+        std::fprintf(stderr,
+                     "femto: error: femto %s does not run across MPI ranks; run it as one process "
+                     "(mpirun runs render, tissue and diffusion: docs/mpi.md)\n",
+                     c.name);
+      return leave(2);
+    }
     int code = 0;
     try {
       code = c.run(args, command_line);

@@ -60,8 +60,9 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
 
-  // Across ranks, every rank traces each pass's photons and beams (the same for all: they
-  // depend on the seed and pass only) and gathers them into its bands of tile rows.
+  // Across ranks, each pass's photons and beams are traced in chunks shared out over the ranks
+  // and every rank receives them all (core/transport/chunked_paths.h); each rank gathers them
+  // into its bands of tile rows.
   const distributed::Comm& comm = opt.comm ? *opt.comm : distributed::alone();
   Progress progress(static_cast<uint64_t>(opt.spp), use_beams ? "beam passes" : "photon passes",
                     opt.quiet, "passes");
@@ -81,7 +82,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       if (use_beams) {
         const int64_t paths = bd.per_pass;
         std::vector<Beam> beams = trace_beams(scene, opt.seed, pass, paths, opt.max_depth,
-                                              photon_t_cut, photon_stats, caustic_beams);
+                                              photon_t_cut, photon_stats, caustic_beams, opt.comm);
         state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, beams.size());
         bvh.build(std::move(beams), beam_schedule.radius());
         pass_bytes += bvh.memory_bytes();
@@ -95,8 +96,8 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
         beam_gather.caustic_only = caustic_beams;
       }
       if (use_photons) {
-        std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass,
-                                                    opt.max_depth, photon_t_cut, photon_stats);
+        std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth,
+                                                    photon_t_cut, photon_stats, opt.comm);
         state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());
         grid.build(std::move(photons), schedule.radius());
         pass_bytes += grid.memory_bytes();
@@ -142,7 +143,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       beam_schedule.advance();
       progress.add(1);
       ++state.units_done;
-      if (comm.root()) state.stats += photon_stats;  // traced by every rank, counted once
+      state.stats += photon_stats;  // across ranks: this rank's chunks (summed at the end)
       if (passes::end_pass(state, stats, pass_start, opt, opt.spp)) break;
     }
   });

@@ -23,6 +23,8 @@ class Comm {
   /// Collective. Rank 0 calls fold(r, bytes of rank r) for r = 0, 1, ... in order (its own
   /// `mine` first); the other ranks send `mine` and return.
   virtual void gather(const std::vector<char>& mine, const Fold& fold) const { fold(0, mine); }
+  /// Collective. Every rank calls fold(r, bytes of rank r) for r = 0, 1, ... in order.
+  virtual void all_gather(const std::vector<char>& mine, const Fold& fold) const { fold(0, mine); }
   /// Collective: rank 0's values become the elementwise sums over all ranks (exact: integers).
   virtual void sum_to_root(std::vector<uint64_t>& values) const { (void)values; }
   /// Collective: rank 0's value, on every rank (sizes, decisions such as stopping early).

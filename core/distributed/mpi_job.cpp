@@ -1,5 +1,5 @@
-// The job under MPI (FEMTO_MPI): MPI_COMM_WORLD, with only the thread that called start() making
-// MPI calls (MPI_THREAD_FUNNELED; oneTBB workers never do).
+// The job under MPI (FEMTO_MPI): MPI_COMM_WORLD. MPI calls come from one thread at a time
+// (MPI_THREAD_SERIALIZED): the command's thread, which oneTBB may run inside a task arena.
 #include <mpi.h>
 
 #include <algorithm>
@@ -48,6 +48,22 @@ class MpiComm final : public Comm {
     }
   }
 
+  void all_gather(const std::vector<char>& mine, const Fold& fold) const override {
+    if (size_ <= 1) return fold(0, mine);
+    std::vector<char> theirs;
+    for (int r = 0; r < size_; ++r) {  // rank r broadcasts its bytes, in pieces
+      const bool me = r == rank_;
+      uint64_t n = me ? mine.size() : 0;
+      MPI_Bcast(&n, 1, MPI_UINT64_T, r, MPI_COMM_WORLD);
+      if (!me) theirs.resize(static_cast<size_t>(n));
+      char* data = me ? const_cast<char*>(mine.data()) : theirs.data();
+      for (size_t at = 0; at < n; at += kPiece)
+        MPI_Bcast(data + at, static_cast<int>(std::min<size_t>(kPiece, n - at)), MPI_BYTE, r,
+                  MPI_COMM_WORLD);
+      fold(r, me ? mine : theirs);
+    }
+  }
+
   void sum_to_root(std::vector<uint64_t>& values) const override {
     if (size_ <= 1) return;
     constexpr size_t piece = kPiece / sizeof(uint64_t);
@@ -86,9 +102,15 @@ bool launched_by_mpi() {
 void start(int& argc, char**& argv) {
   if (!launched_by_mpi() || g_joined) return;
   int provided = 0;
-  if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
+  if (MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS) {
     std::fprintf(stderr, "femto: failure: MPI_Init_thread failed\n");
     std::exit(1);
+  }
+  if (provided < MPI_THREAD_SERIALIZED) {
+    std::fprintf(stderr,
+                 "femto: failure: this MPI library does not allow calls from threads "
+                 "(MPI_THREAD_SERIALIZED)\n");
+    MPI_Abort(MPI_COMM_WORLD, 1);
   }
   // Errors in MPI calls end the job (the default handler), with MPI's own message.
   int rank = 0, size = 1;

@@ -166,7 +166,8 @@ void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, do
 }
 
 std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64_t count,
-                              int max_depth, double t_cut_ps, PathStats& stats, bool caustic_only) {
+                              int max_depth, double t_cut_ps, PathStats& stats, bool caustic_only,
+                              const distributed::Comm* comm) {
   const MediumTracker tracker(scene);
   return trace_in_chunks<Beam>(
       count, kChunk, stats, [&](int64_t i, std::vector<Beam>& out, PathStats& st) {
@@ -189,7 +190,8 @@ std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64
               return true;
             },
             /*segments=*/true);
-      });
+      },
+      comm);
 }
 
 }  // namespace femto

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/distributed/comm.h"
 #include "core/pixel_accumulator.h"
 #include "core/scene.h"
 #include "core/temporal_filter.h"
@@ -89,7 +90,8 @@ struct BeamGather {
 /// surfaces with no medium or diffuse scattering before them (light -> (S|G)+ -> medium).
 std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64_t count,
                               int max_depth, double t_cut_ps, PathStats& stats,
-                              bool caustic_only = false);
+                              bool caustic_only = false,
+                              const distributed::Comm* comm = nullptr);
 
 /// Memory of one pass holding `beams` beams: the traced lists and the tree's copy, and at most
 /// kMaxPieces pieces per beam with their build boxes and nodes.

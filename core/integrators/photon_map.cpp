@@ -78,7 +78,8 @@ void PhotonGather::gather(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& 
 }
 
 std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count,
-                                  int max_depth, double t_cut_ps, PathStats& stats) {
+                                  int max_depth, double t_cut_ps, PathStats& stats,
+                                  const distributed::Comm* comm) {
   const MediumTracker tracker(scene);
   return trace_in_chunks<Photon>(
       count, kChunk, stats, [&](int64_t i, std::vector<Photon>& out, PathStats& st) {
@@ -93,7 +94,8 @@ std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, i
           }
           return false;  // after a diffuse vertex the camera paths take over
         });
-      });
+      },
+      comm);
 }
 
 }  // namespace femto

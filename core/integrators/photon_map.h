@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/bsdf/bsdf.h"
+#include "core/distributed/comm.h"
 #include "core/geometry.h"
 #include "core/pixel_accumulator.h"
 #include "core/scene.h"
@@ -68,8 +69,10 @@ inline uint64_t photon_pass_bytes(int64_t per_pass) {
 
 /// Traces `count` photons of one pass (streams keyed by seed, pass and photon index) and returns
 /// the caustic ones in photon order: the same list for any thread count.
+/// `comm`: ranks that share the tracing (core/distributed/comm.h); each counts its own photons.
 std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count,
-                                  int max_depth, double t_cut_ps, PathStats& stats);
+                                  int max_depth, double t_cut_ps, PathStats& stats,
+                                  const distributed::Comm* comm = nullptr);
 
 template <class F>
 void PhotonGrid::query(const Vec3& x, double radius, F&& f) const {

@@ -5,7 +5,7 @@
 # leaves no output folder (docs/mpi.md).
 # Catches: a split that changes the sums' order (tiles, light chunks, photon passes, tissue
 # chunks, diffusion batches), counters counted twice or lost, a rank writing outputs, a failing
-# rank that hangs the job or exits 0.
+# rank that hangs the job or exits 0, options and commands that cannot run across ranks accepted.
 # Usage: compare_ranks.sh FEMTO MPIEXEC SOURCE_DIR WORK_DIR CASE
 set -u
 femto=$1 mpiexec=$2 src=$3 work=$4 case=$5
@@ -95,6 +95,17 @@ case "$case" in
     [ "$code" = 2 ] || fail "exit code $code, expected 2"
     grep -q "femto: error on rank 1 of 2: .*missing.json" log || fail "rank 1's message not shown"
     [ ! -e out ] || fail "an output folder was written"
-    echo "ok: rank failure ends the job with code 2" ;;
+    echo "ok: rank failure ends the job with code 2"
+    # What does not run across ranks is refused (exit 2, a message, nothing written).
+    mpi2 "$femto" render $scene --spp 1 --checkpoint --out out > log 2>&1
+    code=$?
+    [ "$code" = 2 ] || fail "--checkpoint under mpirun: exit code $code, expected 2"
+    grep -q -- "--checkpoint: not available under mpirun" log || { cat log; fail "no --checkpoint message"; }
+    [ ! -e out ] || fail "--checkpoint under mpirun wrote an output folder"
+    mpi2 "$femto" info $scene > log 2>&1
+    code=$?
+    [ "$code" = 2 ] || fail "femto info under mpirun: exit code $code, expected 2"
+    grep -q "femto info does not run across MPI ranks" log || { cat log; fail "no message for info"; }
+    echo "ok: --checkpoint and femto info are refused under mpirun" ;;
   *) fail "unknown case $case" ;;
 esac
