@@ -48,6 +48,9 @@ def test_overrides_equal_the_command_flags(scene_file, tmp_path):
           "--integrator", "path"]),
         ({"max_depth": 2, "direction_sampling": "angular"},
          ["--max-depth", "2", "--direction-sampling", "angular"]),
+        ({"integrator": "light", "light_paths": 3000}, ["--integrator", "light", "--light-paths", "3000"]),
+        ({"integrator": "photons", "photons": 2000, "photon_radius": 5.0},
+         ["--integrator", "photons", "--photons", "2000", "--photon-radius", "5"]),
     ]
     for i, (keywords, flags) in enumerate(cases):
         expected, record = cli_render(scene_file, tmp_path / f"cli{i}", "--spp", 2, "--seed", 5,
@@ -113,7 +116,7 @@ def test_gil_is_released_while_rendering():
     thread = threading.Thread(target=count)
     thread.start()
     before = len(ticks)
-    femto.render(small_scene(48, 36, 24), spp=24, seed=2)
+    femto.render(small_scene(), spp=8, seed=2)
     during = len(ticks) - before
     stop.set()
     thread.join()
