@@ -1,5 +1,6 @@
 """femto.render against the femto command, and the result's arrays, time axis and record."""
 import gc
+import json
 import threading
 import time
 
@@ -19,12 +20,10 @@ def test_bits_equal_the_command(scene_file, tmp_path):
     assert result.transient.shape == expected.shape
     assert np.array_equal(result.transient, expected)
     # The record matches render.json where both describe the same render.
-    for key in ("settings", "time_axis", "film", "counters", "energy", "media", "scene"):
-        if key == "settings":
-            a = dict(result.meta[key]); b = dict(record[key])
-            assert a == b
-        else:
-            assert result.meta[key] == record[key], key
+    for key in ("settings", "time_axis", "film", "counters", "energy", "media", "scene",
+                "complete", "femto_version", "femto_build"):
+        assert result.meta[key] == record[key], key
+    assert result.meta["progress"]["units_done"] == record["progress"]["units_done"]
 
 
 def test_bits_do_not_depend_on_threads_or_scene_form(scene_file):
@@ -32,7 +31,6 @@ def test_bits_do_not_depend_on_threads_or_scene_form(scene_file):
     scene = small_scene()
     by_path = femto.render(scene_file, spp=2, seed=3, threads=1).transient
     by_dict = femto.render(scene, spp=2, seed=3, threads=2).transient
-    import json
     by_text = femto.render(json.dumps(scene), spp=2, seed=3).transient
     assert np.array_equal(by_path, by_dict)
     assert np.array_equal(by_path, by_text)
