@@ -55,6 +55,12 @@ def test_overrides_equal_the_command_flags(scene_file, tmp_path):
                                       *flags)
         result = femto.render(scene_file, spp=2, seed=5, **keywords)
         assert np.array_equal(result.transient, expected), keywords
+        kernel = keywords.get("reconstruction") == "kernel"
+        assert (result.kernel_bandwidth_ps is not None) == kernel
+        if kernel:
+            bandwidth = result.kernel_bandwidth_ps
+            assert bandwidth.shape == expected.shape[:2] and bandwidth.base is result
+            assert np.isfinite(bandwidth).all() and (bandwidth > 0).any()
         assert result.meta["settings"] == record["settings"], keywords
 
 
