@@ -157,6 +157,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
       std::fputs(kRenderHelp, stdout);
       return 0;
     } else if (parse_render_flag(args, a, overrides)) {
+      // --spp, --seed, --threads and the sampling, film and integrator options
     } else if (a == "--out") {
       out.dir = args.value();
       if (out.dir.empty()) args.fail("expects a folder", "");

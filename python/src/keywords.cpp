@@ -1,5 +1,6 @@
 // Keyword arguments as command flags (python/src/bindings.h).
 #include <algorithm>
+#include <cctype>
 
 #include "python/src/bindings.h"
 

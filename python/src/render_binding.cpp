@@ -218,6 +218,16 @@ void register_render(py::module_& m) {
           "float32 (H, W): time (ps, bin centre) of each pixel's brightest bin; NaN where dark "
           "(peak_time.exr)")
       .def_property_readonly(
+          "kernel_bandwidth_ps",
+          [](const py::object& self) -> py::object {
+            const RenderOutput& out = self.cast<const RenderOutput&>();
+            if (out.result.final_bandwidth_ps.empty()) return py::none();
+            const TransientFilm& f = out.result.film;
+            return film_view(self, out.result.final_bandwidth_ps.data(), {f.height(), f.width()});
+          },
+          "float32 (H, W): kernel film only, each pixel's final temporal bandwidth (ps); None "
+          "for the histogram film")
+      .def_property_readonly(
           "time_axis", [](const RenderOutput& out) { return time_axis_of(out); },
           "dict: render.json's time_axis (ps and OPL mm) plus the arrays centers_ps, edges_ps, "
           "centers_opl_mm and edges_opl_mm")

@@ -62,3 +62,18 @@ def test_uniformity_all_strategies_and_keywords():
     assert set(u) == {"mfp", "time_uniform", "line_to_point", "angular", "equiangular"}
     with pytest.raises(ValueError, match="light"):
         femto.uniformity(light=(1, 2))
+
+
+def test_diffusion_sigint_interrupts():
+    # Catches Ctrl-C ignored during a diffusion run (10^10 photons would take hours).
+    import os
+    import signal
+    import threading
+    import time
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        femto.diffusion(photons=10**10, t_bins=20, r_bins=20)
+    timer.join()
+    assert time.monotonic() - start < 20

@@ -68,3 +68,28 @@ def test_sigint_interrupts_cleanly():
     # Nothing is left running: a new render is as fast as usual and gives the same bits.
     assert np.array_equal(femto.render(small_scene(), spp=2, seed=9).transient,
                           femto.render(small_scene(), spp=2, seed=9, threads=1).transient)
+
+
+def test_ctrl_c_from_outside_ends_a_script(tmp_path):
+    # Catches Ctrl-C (SIGINT from outside, as a terminal sends it) not ending a Python program
+    # stuck in a render: the program must end by KeyboardInterrupt within seconds.
+    import subprocess
+    import sys
+    script = tmp_path / "long_render.py"
+    script.write_text(
+        "import sys, femto\n"
+        "scene = femto.load_scene()['scene']\n"
+        "scene['camera']['resolution'] = [24, 18]\n"
+        "print('rendering', flush=True)\n"
+        "femto.render(scene, spp=100000)\n"
+        "print('finished', flush=True)\n")
+    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=dict(os.environ))
+    assert proc.stdout.readline().strip() == "rendering"
+    time.sleep(0.5)
+    start = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=30)
+    assert time.monotonic() - start < 20
+    assert "KeyboardInterrupt" in err and "finished" not in out
+    assert proc.returncode != 0

@@ -1,5 +1,6 @@
 """femto.render against the femto command, and the result's arrays, time axis and record."""
 import gc
+import json
 import threading
 import time
 
@@ -19,12 +20,10 @@ def test_bits_equal_the_command(scene_file, tmp_path):
     assert result.transient.shape == expected.shape
     assert np.array_equal(result.transient, expected)
     # The record matches render.json where both describe the same render.
-    for key in ("settings", "time_axis", "film", "counters", "energy", "media", "scene"):
-        if key == "settings":
-            a = dict(result.meta[key]); b = dict(record[key])
-            assert a == b
-        else:
-            assert result.meta[key] == record[key], key
+    for key in ("settings", "time_axis", "film", "counters", "energy", "media", "scene",
+                "complete", "femto_version", "femto_build"):
+        assert result.meta[key] == record[key], key
+    assert result.meta["progress"]["units_done"] == record["progress"]["units_done"]
 
 
 def test_bits_do_not_depend_on_threads_or_scene_form(scene_file):
@@ -32,7 +31,6 @@ def test_bits_do_not_depend_on_threads_or_scene_form(scene_file):
     scene = small_scene()
     by_path = femto.render(scene_file, spp=2, seed=3, threads=1).transient
     by_dict = femto.render(scene, spp=2, seed=3, threads=2).transient
-    import json
     by_text = femto.render(json.dumps(scene), spp=2, seed=3).transient
     assert np.array_equal(by_path, by_dict)
     assert np.array_equal(by_path, by_text)
@@ -48,12 +46,21 @@ def test_overrides_equal_the_command_flags(scene_file, tmp_path):
           "--integrator", "path"]),
         ({"max_depth": 2, "direction_sampling": "angular"},
          ["--max-depth", "2", "--direction-sampling", "angular"]),
+        ({"integrator": "light", "light_paths": 3000}, ["--integrator", "light", "--light-paths", "3000"]),
+        ({"integrator": "photons", "photons": 2000, "photon_radius": 5.0},
+         ["--integrator", "photons", "--photons", "2000", "--photon-radius", "5"]),
     ]
     for i, (keywords, flags) in enumerate(cases):
         expected, record = cli_render(scene_file, tmp_path / f"cli{i}", "--spp", 2, "--seed", 5,
                                       *flags)
         result = femto.render(scene_file, spp=2, seed=5, **keywords)
         assert np.array_equal(result.transient, expected), keywords
+        kernel = keywords.get("reconstruction") == "kernel"
+        assert (result.kernel_bandwidth_ps is not None) == kernel
+        if kernel:
+            bandwidth = result.kernel_bandwidth_ps
+            assert bandwidth.shape == expected.shape[:2] and bandwidth.base is result
+            assert np.isfinite(bandwidth).all() and (bandwidth > 0).any()
         assert result.meta["settings"] == record["settings"], keywords
 
 
@@ -113,7 +120,7 @@ def test_gil_is_released_while_rendering():
     thread = threading.Thread(target=count)
     thread.start()
     before = len(ticks)
-    femto.render(small_scene(48, 36, 24), spp=24, seed=2)
+    femto.render(small_scene(), spp=8, seed=2)
     during = len(ticks) - before
     stop.set()
     thread.join()
