@@ -77,6 +77,22 @@ TEST_CASE("exp_moments matches quadrature on both sides of the series switch", "
           Approx((std::exp(-0.5) - std::exp(-1.5)) / 0.5).epsilon(1e-14));
 }
 
+namespace {
+// A random straight flight at speed 0.25 mm/ps: start within `extent` of the origin, start time
+// below t0_max, duration below d_max, weighted by exp(-k t) with k below k_max (0 on odd trials).
+Segment random_segment(Rng& rng, int trial, double extent, double t0_max, double d_max,
+                       double k_max) {
+  Segment s;
+  s.x0 = Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * extent;
+  s.d = sample_uniform_sphere(rng.uniform(), rng.uniform());
+  s.t0 = t0_max * rng.uniform();
+  s.duration = d_max * rng.uniform();
+  s.v = 0.25, s.w0 = 0.7;
+  s.k = trial % 2 ? 0.0 : k_max * rng.uniform();
+  return s;
+}
+}  // namespace
+
 // Catches wrong shell-crossing times, time lost at boundaries, or wrong r^2 / r^4 polynomials.
 TEST_CASE("track-length tallies equal brute-force time integrals of single segments",
           "[diffusion]") {
@@ -86,13 +102,7 @@ TEST_CASE("track-length tallies equal brute-force time integrals of single segme
   grid.dr = 0.3;
   Rng rng(11, 5);
   for (int trial = 0; trial < 40; ++trial) {
-    Segment s;
-    s.x0 = Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * 4.0;
-    s.d = sample_uniform_sphere(rng.uniform(), rng.uniform());
-    s.t0 = 2 * rng.uniform();
-    s.duration = 5 * rng.uniform();
-    s.v = 0.25, s.w0 = 0.7;
-    s.k = trial % 2 ? 0.0 : 0.8 * rng.uniform();
+    const Segment s = random_segment(rng, trial, 4.0, 2.0, 5.0, 0.8);
     PhotonTally tally(grid);
     TallySums sums;
     sums.reset(tally.layout().size());
@@ -147,13 +157,7 @@ TEST_CASE("a photon's consecutive segments tally as one flight", "[diffusion]") 
   grid.dr = 0.35;
   Rng rng(5, 9);
   for (int trial = 0; trial < 20; ++trial) {
-    Segment whole;
-    whole.x0 = Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * 3.0;
-    whole.d = sample_uniform_sphere(rng.uniform(), rng.uniform());
-    whole.t0 = 0.5 * rng.uniform();
-    whole.duration = 3 * rng.uniform();
-    whole.v = 0.25, whole.w0 = 0.7;
-    whole.k = trial % 2 ? 0.0 : 0.6 * rng.uniform();
+    const Segment whole = random_segment(rng, trial, 3.0, 0.5, 3.0, 0.6);
     PhotonTally tally(grid);
     TallySums one, three;
     one.reset(tally.layout().size());
