@@ -127,10 +127,10 @@ SparseVolumeInfo write_sparse_cloud(const std::string& path, int n, uint64_t see
     const auto u = [&](int f) { return hash01(key, p, f, 0); };
     Puff q;
     q.r = n * (0.05 + 0.06 * u(3));
-    // Puffs gather towards the middle and the lower half of the box, like a cumulus.
-    q.c[0] = dims[0] * (0.22 + 0.56 * u(0));
-    q.c[1] = dims[1] * (0.3 + 0.4 * u(1));
-    q.c[2] = dims[2] * (0.2 + 0.6 * u(2) * u(2));
+    // Puffs fill the box out to its faces, denser in its lower half, like a cumulus.
+    q.c[0] = dims[0] * (0.05 + 0.9 * u(0));
+    q.c[1] = dims[1] * (0.1 + 0.8 * u(1));
+    q.c[2] = dims[2] * (0.05 + 0.9 * std::pow(u(2), 1.5));
     for (int a = 0; a < 3; ++a) q.c[a] = std::clamp(q.c[a], q.r + 2, dims[a] - q.r - 2);
     puffs.push_back(q);
   }
