@@ -12,6 +12,7 @@
 #include "core/rng.h"
 #include "media/grid_medium.h"
 #include "media/volume_data.h"
+#include "run_femto.h"
 #include "samplers/medium_distance.h"
 #include "scene_builders.h"
 #include "temp_dir.h"
@@ -361,4 +362,35 @@ TEST_CASE("dense and sparse renders agree bin by bin", "[sparse][statistical]") 
         cells(batches(scene, IntegratorKind::Path, 32, 16, sparse ? 900 : 800), 4, 2);
   }
   require_agreement(cells_of[0], cells_of[1], 15);
+}
+
+// Catches: make-volume's sparse kinds not writing what they report, the `storage` key ignored or
+// accepting anything, and femto info not saying which storage was used.
+TEST_CASE("make-volume plume, the storage key and femto info", "[sparse]") {
+  TempDir tmp("femto_sparse");
+  Run r = run_femto(
+      {"make-volume", "plume", "--resolution", "128", "--voxel", "0.5", "--out", "plume.vdb"},
+      tmp.dir);
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.err,
+             Catch::Contains("128 x 128 x 128 voxel box") && Catch::Contains("active voxels"));
+  const auto scene = [&](const std::string& storage) {
+    write_file(tmp.dir / "s.json",
+               R"({"camera": {"position": [0, 0, 200], "look_at": [0, 0, 0], "resolution": [8, 8]},
+      "time": {"bin_width": 10, "bins": 4},
+      "media": {"vol": {"type": "vdb", "file": "plume.vdb", "sigma_t_scale": 0.1, "storage": )" +
+                   storage + R"(}}, "medium": "vol",
+      "lights": [{"type": "point", "position": [0, 80, 0], "intensity": 1}]})");
+    return run_femto({"info", "s.json"}, tmp.dir);
+  };
+  r = scene("\"sparse\"");
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.out, Catch::Contains("storage:         sparse") && Catch::Contains("leaves") &&
+                        Catch::Contains("OpenVDB trees"));
+  r = scene("\"dense\"");
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.out, Catch::Contains("storage:         dense"));
+  r = scene("\"compressed\"");
+  CHECK(r.code == 2);
+  CHECK_THAT(r.err, Catch::Contains("/media/vol/storage") && Catch::Contains("compressed"));
 }
