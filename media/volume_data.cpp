@@ -161,6 +161,12 @@ class VolumeLoader {
       for (Used& u : used) densify(u, box);
     } else {
       check_sparse_box(box.min(), box.max(), "");
+      // Again from the trees (the metadata may be missing): before any index is allocated.
+      double dim[3];
+      for (int a = 0; a < 3; ++a) dim[a] = double(int64_t(box.max()[a]) - int64_t(box.min()[a]) + 1);
+      const double trees = double(tree_bytes(used));
+      check_sparse_memory(trees + sparse_index_estimate(dim, trees, trilinear()), "about ",
+                          "OpenVDB trees " + fmt_mib(trees) + " + index");
       make_sparse(out, used, box);
     }
     check_sigma_t(used[0], out.density);
