@@ -53,7 +53,8 @@ std::shared_ptr<SparseField> build_sparse_field(std::vector<SparseGridInput>& in
   const int pad = trilinear ? 1 : 0;
   int64_t origin[3];
   for (int a = 0; a < 3; ++a) {
-    origin[a] = (int64_t(box.min()[a]) >> SparseField::kNodeLog2) << SparseField::kNodeLog2;
+    origin[a] = (int64_t(box.min()[a]) >> SparseField::kNodeLog2) *
+                SparseField::kNode;  // floor, no shift of a negative
     f->origin[a] = int(origin[a]);
     f->lo[a] = int(int64_t(box.min()[a]) - origin[a]);
     f->hi[a] = int(int64_t(box.max()[a]) - origin[a] + 1);

@@ -254,7 +254,7 @@ class VolumeLoader {
   // stay below 2^30 voxels.
   void check_sparse_box(const Coord& lo, const Coord& hi, const std::string& what) const {
     for (int a = 0; a < 3; ++a) {
-      const int64_t start = (int64_t(lo[a]) >> SparseField::kNodeLog2) << SparseField::kNodeLog2;
+      const int64_t start = (int64_t(lo[a]) >> SparseField::kNodeLog2) * SparseField::kNode;
       if (int64_t(hi[a]) - start + 1 > (int64_t(1) << 30))
         fail_file("the " + what + "box " + fmt(lo) + " to " + fmt(hi) + " is " +
                   std::to_string(int64_t(hi[a]) - int64_t(lo[a]) + 1) + " voxels along axis " +
