@@ -16,7 +16,9 @@ namespace femto {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-int floor_int(double x) { return clamped_floor(x); }
+int floor_int(double x) {
+  return clamped_floor(x);
+}
 }  // namespace
 
 GridMedium::GridMedium(const VolumeData& data, const VdbMediumDesc& desc)
@@ -154,11 +156,13 @@ double interpolate(const Vec3& q, bool trilinear, Fetch fetch) {
 }  // namespace
 
 double GridMedium::sigma_t_at(const Vec3& p) const {
-  return interpolate(to_field(p), trilinear_, [&](int i, int j, int k) { return field_sigma(i, j, k); });
+  return interpolate(to_field(p), trilinear_,
+                     [&](int i, int j, int k) { return field_sigma(i, j, k); });
 }
 
 double GridMedium::eta_at(const Vec3& p) const {
-  return interpolate(to_field(p), trilinear_, [&](int i, int j, int k) { return field_eta(i, j, k); });
+  return interpolate(to_field(p), trilinear_,
+                     [&](int i, int j, int k) { return field_eta(i, j, k); });
 }
 
 double GridMedium::albedo_at(const Vec3& p) const {
@@ -181,13 +185,13 @@ double GridMedium::albedo_at(const Vec3& p) const {
 // Walker
 
 void GridMedium::Walker::Dda::init(const Vec3& o, const Vec3& d, double s0, double s1,
-                                   const int lo_[3], const int hi_[3], double cs) {
+                                   const int lo_in[3], const int hi_in[3], double cs) {
   s = s0;
   s_end = s1;
   const double s_probe = s0 + 0.5 * std::min(s1 - s0, 1e-9 * (1.0 + std::abs(s0)));
   for (int a = 0; a < 3; ++a) {
-    lo[a] = lo_[a];
-    hi[a] = hi_[a];
+    lo[a] = lo_in[a];
+    hi[a] = hi_in[a];
     const double p = o[a] + d[a] * s_probe;
     cell[a] = std::clamp(floor_int(p / cs), lo[a], hi[a] - 1);
     cs_ = cs;
@@ -210,7 +214,8 @@ void GridMedium::Walker::Dda::init(const Vec3& o, const Vec3& d, double s0, doub
 
 bool GridMedium::Walker::Dda::next(int out[3], double& sa, double& sb) {
   if (s >= s_end) return false;
-  const int axis = s_next[0] < s_next[1] ? (s_next[0] < s_next[2] ? 0 : 2) : (s_next[1] < s_next[2] ? 1 : 2);
+  const int axis =
+      s_next[0] < s_next[1] ? (s_next[0] < s_next[2] ? 0 : 2) : (s_next[1] < s_next[2] ? 1 : 2);
   out[0] = cell[0];
   out[1] = cell[1];
   out[2] = cell[2];
@@ -225,10 +230,12 @@ bool GridMedium::Walker::Dda::next(int out[3], double& sa, double& sb) {
   return true;
 }
 
-GridMedium::Walker::Walker(const GridMedium& m, const Ray& ray, double s_max) : m_(m), s_max_(s_max) {
+GridMedium::Walker::Walker(const GridMedium& m, const Ray& ray, double s_max)
+    : m_(m), s_max_(s_max) {
   oq_ = m.to_field(ray.o);
   const double* w = m.w2g_;
-  dq_ = {w[0] * ray.d.x + w[1] * ray.d.y + w[2] * ray.d.z, w[4] * ray.d.x + w[5] * ray.d.y + w[6] * ray.d.z,
+  dq_ = {w[0] * ray.d.x + w[1] * ray.d.y + w[2] * ray.d.z,
+         w[4] * ray.d.x + w[5] * ray.d.y + w[6] * ray.d.z,
          w[8] * ray.d.x + w[9] * ray.d.y + w[10] * ray.d.z};
   // Clip [0, s_max] to the field box [lo, m]^3 (lo = 0 when dense).
   double s0 = 0, s1 = s_max;
@@ -386,9 +393,11 @@ void GridMedium::Walker::set_views(const int b[3]) {
   for (int a = 0; a < 3; ++a) view_base_[a] = b[a] - pad;
   const int lim[3] = {f.nn[0] * 16, f.nn[1] * 16, f.nn[2] * 16};
   for (int v = 0; v < (pad ? 8 : 1); ++v) {
-    const int l[3] = {view_base_[0] + (v & 1), view_base_[1] + ((v >> 1) & 1), view_base_[2] + ((v >> 2) & 1)};
+    const int l[3] = {view_base_[0] + (v & 1), view_base_[1] + ((v >> 1) & 1),
+                      view_base_[2] + ((v >> 2) & 1)};
     if (l[0] < 0 || l[1] < 0 || l[2] < 0 || l[0] >= lim[0] || l[1] >= lim[1] || l[2] >= lim[2]) {
-      views_[v] = SparseField::Brick{};  // outside every node: never read (the box test comes first)
+      views_[v] =
+          SparseField::Brick{};  // outside every node: never read (the box test comes first)
       continue;
     }
     views_[v] = f.view(f.leaf(l[0], l[1], l[2]));

@@ -73,8 +73,8 @@ class GridMedium {
       int cell[3], step[3], lo[3], hi[3];
       double s_next[3], inv_d[3], o_[3], cs_, s, s_end;
       double plane(int a, int c) const { return (c * cs_ - o_[a]) * inv_d[a]; }
-      void init(const Vec3& o, const Vec3& d, double s0, double s1, const int lo_[3], const int hi_[3],
-                double cell_size);
+      void init(const Vec3& o, const Vec3& d, double s0, double s1, const int lo_in[3],
+                const int hi_in[3], double cell_size);
       bool next(int out[3], double& sa, double& sb);
     };
     template <class Fetch>
@@ -105,13 +105,13 @@ class GridMedium {
 
   bool trilinear_ = false;
   bool skip_empty_ = true;
-  int lo_[3] = {0, 0, 0};       // first field cell (sparse: the box starts inside a node)
-  int n_[3] = {0, 0, 0};        // voxels
-  int m_[3] = {0, 0, 0};        // field cells: n (nearest) or n + 1 (trilinear, dual cells)
-  int nb_[3] = {0, 0, 0};       // blocks
+  int lo_[3] = {0, 0, 0};  // first field cell (sparse: the box starts inside a node)
+  int n_[3] = {0, 0, 0};   // voxels
+  int m_[3] = {0, 0, 0};   // field cells: n (nearest) or n + 1 (trilinear, dual cells)
+  int nb_[3] = {0, 0, 0};  // blocks
   std::vector<float> sigma_t_, albedo_, eta_;  // per voxel; albedo_/eta_ empty when constant
   double albedo_const_ = 1, eta_const_ = 1, eta_outside_ = 1;
-  double w2g_[12];              // world -> grid (voxel (i,j,k) covers [i, i+1]^3)
+  double w2g_[12];  // world -> grid (voxel (i,j,k) covers [i, i+1]^3)
   double max_sigma_t_ = 0, mean_sigma_t_ = 0;
   std::vector<float> block_sigma_max_, block_eta_;  // block_eta_ < 0: index varies in the block
   std::shared_ptr<const SparseField> sparse_;       // sparse storage (then the vectors are empty)
