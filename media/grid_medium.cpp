@@ -93,7 +93,7 @@ void GridMedium::init_sparse(const VolumeData& data, const VdbMediumDesc& desc) 
   // World -> field voxel coordinates: the grid space of VolumeData shifted by the box start.
   std::copy(data.world_to_grid, data.world_to_grid + 12, w2g_);
   for (int a = 0; a < 3; ++a) w2g_[4 * a + 3] += f.lo[a];
-  max_sigma_t_ = desc.sigma_t_scale * f.max_density;
+  max_sigma_t_ = static_cast<float>(desc.sigma_t_scale * f.max_density);  // as the stored floats
   double cells = 1;
   for (int a = 0; a < 3; ++a) cells *= double(f.hi[a] - f.lo[a]);
   mean_sigma_t_ = cells > 0 ? desc.sigma_t_scale * f.sum_density / cells : 0.0;
