@@ -408,7 +408,6 @@ class VolumeLoader {
     if (!meta->transform().isLinear())
       fail(u, grid + " has a non-linear transform (" + meta->transform().mapType() +
                   "); only affine (linear) transforms are supported");
-    if (!meta->isType<FloatGrid>()) return meta;  // unreachable: refused above
     return meta;
   }
 
