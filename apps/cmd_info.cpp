@@ -21,8 +21,9 @@ const char* kInfoHelp =
     "Loads and validates SCENE.json and every VDB volume it uses (without rendering), then\n"
     "prints a summary: camera, time axis in ps and in optical path length (mm), shapes, lights\n"
     "and, for each medium, its type and coefficients. For a \"vdb\" medium also: file, grids\n"
-    "used, world bounding box, voxel size, dense resolution, active voxels, value ranges\n"
-    "(density, sigma_t = sigma_t_scale * density, albedo, eta) and the memory of the dense grids.\n"
+    "used, world bounding box, voxel size, box resolution, active voxels, value ranges\n"
+    "(density, sigma_t = sigma_t_scale * density, albedo, eta), the storage (dense, or sparse\n"
+    "with its leaf and tile counts) and its memory.\n"
     "A .xml scene is read as Mitsuba 3 / mitransient XML (a subset, docs/mitsuba.md).\n"
     "Exit code 2 with a one-line message naming the file, key and value on bad input.\n"
     "\n"
@@ -79,24 +80,36 @@ void print_vdb(const VdbMediumDesc& d, const VolumeData& v) {
   const DenseGrid& g = v.density;
   // 64-bit: a box touching INT_MAX would overflow index_min + n - 1 in int.
   const auto last = [&](int a, int n) { return static_cast<long long>(v.index_min[a]) + n - 1; };
-  std::printf("    dense grid:      %d x %d x %d cells (%llu), VDB index box (%d, %d, %d) to (%lld, %lld, %lld)\n",
-              g.nx, g.ny, g.nz, static_cast<unsigned long long>(g.v.size()), v.index_min[0],
-              v.index_min[1], v.index_min[2], last(0, g.nx), last(1, g.ny), last(2, g.nz));
-  std::printf("    active voxels:   %llu (%.3g%% of the dense cells)\n",
-              static_cast<unsigned long long>(v.active_voxels),
-              100.0 * static_cast<double>(v.active_voxels) / static_cast<double>(g.v.size()));
+  const uint64_t cells = uint64_t(g.nx) * uint64_t(g.ny) * uint64_t(g.nz);
+  std::printf("    %s      %d x %d x %d cells (%llu), VDB index box (%d, %d, %d) to (%lld, %lld, %lld)\n",
+              v.sparse ? "box:       " : "dense grid:", g.nx, g.ny, g.nz, static_cast<unsigned long long>(cells),
+              v.index_min[0], v.index_min[1], v.index_min[2], last(0, g.nx), last(1, g.ny), last(2, g.nz));
+  std::printf("    active voxels:   %llu (%.3g%% of the box)\n", static_cast<unsigned long long>(v.active_voxels),
+              100.0 * static_cast<double>(v.active_voxels) / static_cast<double>(cells));
   std::printf("    density:         %s\n", range(g.min_value, g.max_value).c_str());
   std::printf("    sigma_t:         %s /mm (sigma_t_scale %s)\n",
               range(d.sigma_t_scale * g.min_value, d.sigma_t_scale * g.max_value).c_str(),
               g6(d.sigma_t_scale).c_str());
   std::printf("    albedo:          %s\n",
-              v.albedo.empty() ? (g6(d.albedo) + " (constant)").c_str()
+              d.albedo_grid.empty() ? (g6(d.albedo) + " (constant)").c_str()
                                : (range(v.albedo.min_value, v.albedo.max_value) + " (grid)").c_str());
   std::printf("    eta:             %s; %s outside the grid box\n",
-              v.eta.empty() ? (g6(d.eta) + " (constant)").c_str()
+              d.eta_grid.empty() ? (g6(d.eta) + " (constant)").c_str()
                             : (range(v.eta.min_value, v.eta.max_value) + " (grid)").c_str(),
               g6(d.eta).c_str());
-  std::printf("    memory:          %s (dense float grids)\n", cli::format_bytes(v.memory_bytes()).c_str());
+  if (v.sparse) {
+    const SparseField& f = *v.sparse;
+    std::printf("    storage:         sparse (%s): %llu leaves, %llu active tiles over all grids used\n",
+                d.storage == VdbMediumDesc::Storage::Sparse ? "storage \"sparse\"" : "chosen automatically",
+                static_cast<unsigned long long>(f.leaf_count), static_cast<unsigned long long>(f.tile_count));
+    std::printf("    memory:          %s (OpenVDB trees %s, index and bounds %s)\n",
+                cli::format_bytes(v.memory_bytes()).c_str(), cli::format_bytes(f.tree_bytes).c_str(),
+                cli::format_bytes(f.index_bytes()).c_str());
+  } else {
+    std::printf("    storage:         dense (%s)\n",
+                d.storage == VdbMediumDesc::Storage::Dense ? "storage \"dense\"" : "chosen automatically");
+    std::printf("    memory:          %s (dense float grids)\n", cli::format_bytes(v.memory_bytes()).c_str());
+  }
 }
 
 int cmd_info(const std::vector<std::string>& argv, const std::string&) {

@@ -309,7 +309,10 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
                      ": lower the resolution, the number of bins or photons per pass, or raise --max-memory");
   // Volumes share --max-memory with the render; the renderer keeps a second copy of their grids.
   const uint64_t left_for_volumes = max_memory > render_bytes ? max_memory - render_bytes : 0;
-  for (MediumDesc& m : desc.media) m.vdb.max_dense_bytes = left_for_volumes / 2;
+  for (MediumDesc& m : desc.media) {
+    m.vdb.max_dense_bytes = left_for_volumes / 2;
+    m.vdb.max_sparse_bytes = left_for_volumes;  // sparse grids are shared, not copied
+  }
 
   // Checkpoint and resume: the fingerprint holds everything that decides the bits.
   const nlohmann::json fingerprint = render_fingerprint(scene_text, desc, kind, opt);

@@ -102,6 +102,10 @@ struct VdbMediumDesc {
   Interpolation interpolation = Interpolation::Nearest;
   TransformDesc transform;
   uint64_t max_dense_bytes = 16ull << 30;  ///< memory allowed for the dense grids (--max-memory)
+  /// How the grids are kept in memory (docs/volumes.md, "Dense or sparse").
+  enum class Storage { Auto, Dense, Sparse };
+  Storage storage = Storage::Auto;
+  uint64_t max_sparse_bytes = 64ull << 30;  ///< memory allowed for sparse grids (--max-memory)
 };
 
 struct MediumDesc {

@@ -643,7 +643,7 @@ class Loader {
                          "connection_sampling", "direction_sampling"};
     const Keys homogeneous = {"sigma_a", "sigma_s"};
     const Keys vdb = {"file",        "density_grid", "sigma_t_scale", "albedo",
-                      "albedo_grid", "eta_grid",     "interpolation", "transform"};
+                      "albedo_grid", "eta_grid",     "interpolation", "transform", "storage"};
     for (const auto& item : v.items()) {
       const std::string& name = item.key();
       const std::string mp = at(p, name);
@@ -701,6 +701,12 @@ class Loader {
       d.interpolation = choice(*i, at(mp, "interpolation"), {"nearest", "trilinear"}) == "nearest"
                             ? VdbMediumDesc::Interpolation::Nearest
                             : VdbMediumDesc::Interpolation::Trilinear;
+    if (const Json* st = find(o, "storage")) {
+      const std::string c = choice(*st, at(mp, "storage"), {"auto", "dense", "sparse"});
+      d.storage = c == "dense"    ? VdbMediumDesc::Storage::Dense
+                  : c == "sparse" ? VdbMediumDesc::Storage::Sparse
+                                  : VdbMediumDesc::Storage::Auto;
+    }
     if (const Json* t = find(o, "transform")) {
       const Transform tf = transform(*t, at(mp, "transform"));
       d.transform = {tf.translate, tf.rotate_deg, tf.scale};

@@ -43,6 +43,7 @@ bool load(bool all_grids) {
   femto::VdbMediumDesc d;
   d.file = g_path;
   d.max_dense_bytes = 64ull << 20;
+  d.max_sparse_bytes = 64ull << 20;
   d.interpolation = femto::VdbMediumDesc::Interpolation::Trilinear;
   if (all_grids) {
     d.albedo_grid = "albedo";

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "core/scene_desc.h"
 #include "media/volume_data.h"
@@ -15,7 +16,9 @@ namespace femto {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-int floor_int(double x) { return clamped_floor(x); }
+int floor_int(double x) {
+  return clamped_floor(x);
+}
 }  // namespace
 
 GridMedium::GridMedium(const VolumeData& data, const VdbMediumDesc& desc)
@@ -23,6 +26,10 @@ GridMedium::GridMedium(const VolumeData& data, const VdbMediumDesc& desc)
       albedo_const_(desc.albedo),
       eta_const_(desc.eta),
       eta_outside_(desc.eta) {
+  if (data.sparse) {
+    init_sparse(data, desc);
+    return;
+  }
   n_[0] = data.density.nx;
   n_[1] = data.density.ny;
   n_[2] = data.density.nz;
@@ -69,12 +76,43 @@ GridMedium::GridMedium(const VolumeData& data, const VdbMediumDesc& desc)
   });
 }
 
+void GridMedium::init_sparse(const VolumeData& data, const VdbMediumDesc& desc) {
+  const SparseField& f = *data.sparse;
+  // The bounds were built for one interpolation, scale and outside index.
+  if (f.trilinear != trilinear_ || f.sigma_t_scale != desc.sigma_t_scale ||
+      f.eta_outside != static_cast<float>(desc.eta))
+    throw std::logic_error("GridMedium: the sparse volume was loaded with another description");
+  sparse_ = data.sparse;
+  const int pad = trilinear_ ? 1 : 0;
+  for (int a = 0; a < 3; ++a) {
+    lo_[a] = f.lo[a];
+    n_[a] = f.hi[a];
+    m_[a] = f.hi[a] + pad;
+    nb_[a] = (m_[a] + kBlock - 1) / kBlock;
+  }
+  // World -> field voxel coordinates: the grid space of VolumeData shifted by the box start.
+  std::copy(data.world_to_grid, data.world_to_grid + 12, w2g_);
+  for (int a = 0; a < 3; ++a) w2g_[4 * a + 3] += f.lo[a];
+  max_sigma_t_ = static_cast<float>(desc.sigma_t_scale * f.max_density);  // as the stored floats
+  double cells = 1;
+  for (int a = 0; a < 3; ++a) cells *= double(f.hi[a] - f.lo[a]);
+  mean_sigma_t_ = cells > 0 ? desc.sigma_t_scale * f.sum_density / cells : 0.0;
+}
+
 float GridMedium::field_sigma(int i, int j, int k) const {
+  return sparse_ ? sparse_->sigma_t(i, j, k) : dense_sigma(i, j, k);
+}
+
+float GridMedium::field_eta(int i, int j, int k) const {
+  return sparse_ ? sparse_->eta(i, j, k) : dense_eta(i, j, k);
+}
+
+float GridMedium::dense_sigma(int i, int j, int k) const {
   if (i < 0 || j < 0 || k < 0 || i >= n_[0] || j >= n_[1] || k >= n_[2]) return 0.0f;
   return sigma_t_[(static_cast<size_t>(k) * n_[1] + j) * n_[0] + i];
 }
 
-float GridMedium::field_eta(int i, int j, int k) const {
+float GridMedium::dense_eta(int i, int j, int k) const {
   if (i < 0 || j < 0 || k < 0 || i >= n_[0] || j >= n_[1] || k >= n_[2])
     return static_cast<float>(eta_outside_);
   if (eta_.empty()) return static_cast<float>(eta_const_);
@@ -89,10 +127,12 @@ Vec3 GridMedium::to_field(const Vec3& p) const {
 }
 
 uint64_t GridMedium::block_memory_bytes() const {
+  if (sparse_) return sparse_->index_bytes();
   return (block_sigma_max_.size() + block_eta_.size()) * sizeof(float);
 }
 
 uint64_t GridMedium::field_memory_bytes() const {
+  if (sparse_) return sparse_->tree_bytes;
   return (sigma_t_.size() + albedo_.size() + eta_.size()) * sizeof(float);
 }
 
@@ -116,14 +156,22 @@ double interpolate(const Vec3& q, bool trilinear, Fetch fetch) {
 }  // namespace
 
 double GridMedium::sigma_t_at(const Vec3& p) const {
-  return interpolate(to_field(p), trilinear_, [&](int i, int j, int k) { return field_sigma(i, j, k); });
+  return interpolate(to_field(p), trilinear_,
+                     [&](int i, int j, int k) { return field_sigma(i, j, k); });
 }
 
 double GridMedium::eta_at(const Vec3& p) const {
-  return interpolate(to_field(p), trilinear_, [&](int i, int j, int k) { return field_eta(i, j, k); });
+  return interpolate(to_field(p), trilinear_,
+                     [&](int i, int j, int k) { return field_eta(i, j, k); });
 }
 
 double GridMedium::albedo_at(const Vec3& p) const {
+  if (sparse_)
+    return interpolate(to_field(p), trilinear_, [&](int i, int j, int k) {
+      const SparseField& f = *sparse_;  // outside the box sigma_t is 0: any albedo will do
+      return f.albedo(std::clamp(i, f.lo[0], f.hi[0] - 1), std::clamp(j, f.lo[1], f.hi[1] - 1),
+                      std::clamp(k, f.lo[2], f.hi[2] - 1));
+    });
   if (albedo_.empty()) return albedo_const_;
   return interpolate(to_field(p), trilinear_, [&](int i, int j, int k) {
     i = std::clamp(i, 0, n_[0] - 1);  // outside the grid sigma_t is 0: any albedo will do
@@ -137,34 +185,37 @@ double GridMedium::albedo_at(const Vec3& p) const {
 // Walker
 
 void GridMedium::Walker::Dda::init(const Vec3& o, const Vec3& d, double s0, double s1,
-                                   const int lo_[3], const int hi_[3], double cs) {
+                                   const int lo_in[3], const int hi_in[3], double cs) {
   s = s0;
   s_end = s1;
   const double s_probe = s0 + 0.5 * std::min(s1 - s0, 1e-9 * (1.0 + std::abs(s0)));
   for (int a = 0; a < 3; ++a) {
-    lo[a] = lo_[a];
-    hi[a] = hi_[a];
+    lo[a] = lo_in[a];
+    hi[a] = hi_in[a];
     const double p = o[a] + d[a] * s_probe;
     cell[a] = std::clamp(floor_int(p / cs), lo[a], hi[a] - 1);
+    cs_ = cs;
+    o_[a] = o[a];
     if (d[a] > 0) {
       step[a] = 1;
-      s_next[a] = ((cell[a] + 1) * cs - o[a]) / d[a];
-      s_delta[a] = cs / d[a];
+      inv_d[a] = 1.0 / d[a];
+      s_next[a] = plane(a, cell[a] + 1);
     } else if (d[a] < 0) {
       step[a] = -1;
-      s_next[a] = (cell[a] * cs - o[a]) / d[a];
-      s_delta[a] = -cs / d[a];
+      inv_d[a] = 1.0 / d[a];
+      s_next[a] = plane(a, cell[a]);
     } else {
       step[a] = 0;
+      inv_d[a] = 0;
       s_next[a] = kInf;
-      s_delta[a] = kInf;
     }
   }
 }
 
 bool GridMedium::Walker::Dda::next(int out[3], double& sa, double& sb) {
   if (s >= s_end) return false;
-  const int axis = s_next[0] < s_next[1] ? (s_next[0] < s_next[2] ? 0 : 2) : (s_next[1] < s_next[2] ? 1 : 2);
+  const int axis =
+      s_next[0] < s_next[1] ? (s_next[0] < s_next[2] ? 0 : 2) : (s_next[1] < s_next[2] ? 1 : 2);
   out[0] = cell[0];
   out[1] = cell[1];
   out[2] = cell[2];
@@ -172,24 +223,28 @@ bool GridMedium::Walker::Dda::next(int out[3], double& sa, double& sb) {
   sb = std::min(std::max(s_next[axis], s), s_end);
   s = sb;
   cell[axis] += step[axis];
-  s_next[axis] += s_delta[axis];
+  // Each crossing from its own plane (no running sum): the same plane gives the same distance
+  // at every level of the walk (cells, blocks, nodes) and wherever the walk started.
+  s_next[axis] = plane(axis, step[axis] > 0 ? cell[axis] + 1 : cell[axis]);
   if (cell[axis] < lo[axis] || cell[axis] >= hi[axis]) s = s_end;
   return true;
 }
 
-GridMedium::Walker::Walker(const GridMedium& m, const Ray& ray, double s_max) : m_(m), s_max_(s_max) {
+GridMedium::Walker::Walker(const GridMedium& m, const Ray& ray, double s_max)
+    : m_(m), s_max_(s_max) {
   oq_ = m.to_field(ray.o);
   const double* w = m.w2g_;
-  dq_ = {w[0] * ray.d.x + w[1] * ray.d.y + w[2] * ray.d.z, w[4] * ray.d.x + w[5] * ray.d.y + w[6] * ray.d.z,
+  dq_ = {w[0] * ray.d.x + w[1] * ray.d.y + w[2] * ray.d.z,
+         w[4] * ray.d.x + w[5] * ray.d.y + w[6] * ray.d.z,
          w[8] * ray.d.x + w[9] * ray.d.y + w[10] * ray.d.z};
-  // Clip [0, s_max] to the field box [0, m]^3.
+  // Clip [0, s_max] to the field box [lo, m]^3 (lo = 0 when dense).
   double s0 = 0, s1 = s_max;
   for (int a = 0; a < 3 && s0 <= s1; ++a) {
     if (dq_[a] == 0) {
-      if (oq_[a] < 0 || oq_[a] > m.m_[a]) s1 = -1;
+      if (oq_[a] < m.lo_[a] || oq_[a] > m.m_[a]) s1 = -1;
       continue;
     }
-    double ta = (0 - oq_[a]) / dq_[a], tb = (m.m_[a] - oq_[a]) / dq_[a];
+    double ta = (m.lo_[a] - oq_[a]) / dq_[a], tb = (m.m_[a] - oq_[a]) / dq_[a];
     if (ta > tb) std::swap(ta, tb);
     s0 = std::max(s0, ta);
     s1 = std::min(s1, tb);
@@ -197,19 +252,31 @@ GridMedium::Walker::Walker(const GridMedium& m, const Ray& ray, double s_max) : 
   if (s0 < s1) {
     s_in_ = s0;
     s_out_ = s1;
-    const int lo[3] = {0, 0, 0};
-    blocks_.init(oq_, dq_, s_in_, s_out_, lo, m.nb_, static_cast<double>(kBlock));
+    if (m.sparse_) {
+      const SparseField& f = *m.sparse_;
+      const int lo[3] = {m.lo_[0] >> SparseField::kNodeLog2, m.lo_[1] >> SparseField::kNodeLog2,
+                         m.lo_[2] >> SparseField::kNodeLog2};
+      nodes_.init(oq_, dq_, s_in_, s_out_, lo, f.nn, static_cast<double>(SparseField::kNode));
+      in_node_ = false;
+    } else {
+      const int lo[3] = {0, 0, 0};
+      blocks_.init(oq_, dq_, s_in_, s_out_, lo, m.nb_, static_cast<double>(kBlock));
+    }
   } else {
     s_in_ = s_out_ = s_max;
   }
 }
 
-void GridMedium::Walker::cell_segment(const int c[3], double sa, double sb, MediumSegment& seg) const {
+template <class Fetch>
+void GridMedium::Walker::cell_segment(const int c[3], double sa, double sb, MediumSegment& seg,
+                                      Fetch fetch) const {
   seg.s0 = sa;
   seg.s1 = sb;
   if (!m_.trilinear_) {
-    seg.sigma_t = Poly3::constant(m_.field_sigma(c[0], c[1], c[2]));
-    seg.eta = Poly3::constant(m_.field_eta(c[0], c[1], c[2]));
+    float s, e;
+    fetch(c[0], c[1], c[2], s, e);
+    seg.sigma_t = Poly3::constant(s);
+    seg.eta = Poly3::constant(e);
     return;
   }
   // Dual cell c spans voxel centres c - 1 and c on each axis; local coordinate u = q - c.
@@ -222,8 +289,7 @@ void GridMedium::Walker::cell_segment(const int c[3], double sa, double sb, Medi
   bool s_const = true, e_const = true;
   for (int k = 0; k < 8; ++k) {
     const int i = c[0] - 1 + (k & 1), j = c[1] - 1 + ((k >> 1) & 1), l = c[2] - 1 + ((k >> 2) & 1);
-    sv[k] = m_.field_sigma(i, j, l);
-    ev[k] = m_.field_eta(i, j, l);
+    fetch(i, j, l, sv[k], ev[k]);
     s_const = s_const && sv[k] == sv[0];
     e_const = e_const && ev[k] == ev[0];
   }
@@ -261,10 +327,34 @@ bool GridMedium::Walker::next(MediumSegment& seg) {
         int c[3];
         double sa, sb;
         if (cells_.next(c, sa, sb)) {
-          cell_segment(c, sa, sb, seg);
+          if (m_.sparse_) {
+            cell_segment(c, sa, sb, seg, [this](int i, int j, int k, float& s, float& e) {
+              const SparseField& f = *m_.sparse_;
+              if (!f.inside(i, j, k)) {
+                s = 0.0f;
+                e = f.eta_outside;
+                return;
+              }
+              const int slot = ((i >> 3) - view_base_[0]) | (((j >> 3) - view_base_[1]) << 1) |
+                               (((k >> 3) - view_base_[2]) << 2);
+              const SparseField::Brick& b = views_[slot];
+              const int o = SparseField::voxel_in_leaf(i, j, k);
+              s = static_cast<float>(f.sigma_t_scale * (b.density ? b.density[o] : b.density_c));
+              e = b.eta ? b.eta[o] : b.eta_c;
+            });
+          } else {
+            cell_segment(c, sa, sb, seg, [this](int i, int j, int k, float& s, float& e) {
+              s = m_.dense_sigma(i, j, k);
+              e = m_.dense_eta(i, j, k);
+            });
+          }
           return true;
         }
         in_block_ = false;
+      }
+      if (m_.sparse_) {
+        if (next_sparse_block(seg)) return true;
+        continue;
       }
       int b[3];
       double sa, sb;
@@ -295,6 +385,70 @@ bool GridMedium::Walker::next(MediumSegment& seg) {
     }
     return false;
   }
+}
+
+void GridMedium::Walker::set_views(const int b[3]) {
+  const SparseField& f = *m_.sparse_;
+  const int pad = m_.trilinear_ ? 1 : 0;  // dual cells of block b read leaves b - 1 and b
+  for (int a = 0; a < 3; ++a) view_base_[a] = b[a] - pad;
+  const int lim[3] = {f.nn[0] * 16, f.nn[1] * 16, f.nn[2] * 16};
+  for (int v = 0; v < (pad ? 8 : 1); ++v) {
+    const int l[3] = {view_base_[0] + (v & 1), view_base_[1] + ((v >> 1) & 1),
+                      view_base_[2] + ((v >> 2) & 1)};
+    if (l[0] < 0 || l[1] < 0 || l[2] < 0 || l[0] >= lim[0] || l[1] >= lim[1] || l[2] >= lim[2]) {
+      views_[v] =
+          SparseField::Brick{};  // outside every node: never read (the box test comes first)
+      continue;
+    }
+    views_[v] = f.view(f.leaf(l[0], l[1], l[2]));
+  }
+}
+
+// Sparse: the next node or leaf block. Constant ones become one segment; otherwise the walk
+// descends (returns false, the caller continues with the block's or node's cells).
+bool GridMedium::Walker::next_sparse_block(MediumSegment& seg) {
+  const SparseField& f = *m_.sparse_;
+  double sa, sb;
+  if (!in_node_) {
+    int n[3];
+    if (!nodes_.next(n, sa, sb)) {
+      phase_ = 2;
+      return false;
+    }
+    node_ = f.node_index(n[0], n[1], n[2]);
+    const SparseBound& nb = f.node_bound[node_];
+    if (m_.skip_empty_ && nb.constant()) {
+      seg = {sa, sb, Poly3::constant(nb.sigma_max), Poly3::constant(nb.eta)};
+      return true;
+    }
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(n[a] * 16, m_.lo_[a] / kBlock);
+      hi[a] = std::min(n[a] * 16 + 16, m_.nb_[a]);
+    }
+    blocks_.init(oq_, dq_, sa, sb, lo, hi, static_cast<double>(kBlock));
+    in_node_ = true;
+    return false;
+  }
+  int b[3];
+  if (!blocks_.next(b, sa, sb)) {
+    in_node_ = false;
+    return false;
+  }
+  const SparseBound& bb = f.block_bound(node_, b[0], b[1], b[2]);
+  if (m_.skip_empty_ && bb.constant()) {
+    seg = {sa, sb, Poly3::constant(bb.sigma_max), Poly3::constant(bb.eta)};
+    return true;
+  }
+  int lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::max(b[a] * kBlock, m_.lo_[a]);
+    hi[a] = std::min(b[a] * kBlock + kBlock, m_.m_[a]);
+  }
+  set_views(b);
+  cells_.init(oq_, dq_, sa, sb, lo, hi, 1.0);
+  in_block_ = true;
+  return false;
 }
 
 }  // namespace femto

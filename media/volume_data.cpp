@@ -18,6 +18,7 @@
 #include "core/constants.h"
 #include "core/error.h"
 #include "core/io/atomic_file.h"
+#include "media/sparse_from_vdb.h"
 #include "media/vdb_structure.h"
 
 namespace femto {
@@ -33,6 +34,7 @@ void DenseGrid::update_range() {
 }
 
 uint64_t VolumeData::memory_bytes() const {
+  if (sparse) return sparse->tree_bytes + sparse->index_bytes();
   return (density.v.size() + albedo.v.size() + eta.v.size()) * sizeof(float);
 }
 
@@ -153,9 +155,20 @@ class VolumeLoader {
       fail(used[0], "grid '" + used[0].name + "' has no active voxels, so the medium is empty");
     out.active_voxels = density.activeVoxelCount();
 
-    check_box(box.min(), box.max(), used.size(), "");
-
-    for (Used& u : used) densify(u, box);
+    if (storage_ == Storage::Auto) storage_ = choose(box, used, tree_bytes(used));
+    if (storage_ == Storage::Dense) {
+      check_box(box.min(), box.max(), used.size(), "");
+      for (Used& u : used) densify(u, box);
+    } else {
+      check_sparse_box(box.min(), box.max(), "");
+      // Again from the trees (the metadata may be missing): before any index is allocated.
+      double dim[3];
+      for (int a = 0; a < 3; ++a) dim[a] = double(int64_t(box.max()[a]) - int64_t(box.min()[a]) + 1);
+      const double trees = double(tree_bytes(used));
+      check_sparse_memory(trees + sparse_index_estimate(dim, trees, trilinear()), "about ",
+                          "OpenVDB trees " + fmt_mib(trees) + " + index");
+      make_sparse(out, used, box);
+    }
     check_sigma_t(used[0], out.density);
     set_transform(out, density.transform(), box.min());
     for (int a = 0; a < 3; ++a) out.index_min[a] = box.min()[a];
@@ -163,8 +176,134 @@ class VolumeLoader {
   }
 
  private:
+  using Storage = VdbMediumDesc::Storage;
   const VdbMediumDesc& desc_;
   std::string prefix_;
+  Storage storage_ = desc_.storage;  // Auto until decided, from the metadata or the trees
+
+  static uint64_t tree_bytes(const std::vector<Used>& used) {
+    uint64_t b = 0;
+    for (const Used& u : used) b += u.grid->memUsage();
+    return b;
+  }
+
+  // Memory of the sparse index for a box (voxels) and trees of `trees` bytes: node arrays over
+  // the box, and per node with leaves (at most one per 2 KiB of tree) a leaf table and bounds.
+  static double sparse_index_estimate(const double dim[3], double trees, bool trilinear) {
+    double nodes = 1;
+    for (int a = 0; a < 3; ++a) nodes *= std::ceil((dim[a] + 256) / 128);
+    const double leaves = trees / 2048;
+    const double tabled = std::min(nodes, leaves) * (trilinear ? 2 : 1);
+    return nodes * (sizeof(uint32_t) * 2 + sizeof(SparseBound)) +
+           tabled * SparseField::kLeavesPerNode * (sizeof(uint32_t) + sizeof(SparseBound)) +
+           leaves * sizeof(SparseField::Brick);
+  }
+
+  // The documented rule (docs/volumes.md, "Dense or sparse"): dense while its box fits the
+  // dense limits and costs at most 4x the sparse storage (or under 64 MiB), else sparse.
+  Storage choose_from(const double dim[3], std::size_t grids, double trees) const {
+    const double cells = dim[0] * dim[1] * dim[2];
+    const double dense = cells * sizeof(float) * double(grids);
+    const double sparse = trees + sparse_index_estimate(dim, trees, trilinear());
+    const double limit = double(std::min(kMaxDenseBytes, desc_.max_dense_bytes));
+    if (cells > kMaxCells || dense > limit) return Storage::Sparse;
+    return dense <= std::max(64.0 * (1 << 20), 4 * sparse) ? Storage::Dense : Storage::Sparse;
+  }
+  Storage choose(const CoordBBox& box, const std::vector<Used>& used, uint64_t trees) const {
+    double dim[3];
+    for (int a = 0; a < 3; ++a) dim[a] = double(int64_t(box.max()[a]) - int64_t(box.min()[a]) + 1);
+    return choose_from(dim, used.size(), double(trees));
+  }
+  bool trilinear() const { return desc_.interpolation == VdbMediumDesc::Interpolation::Trilinear; }
+
+  // Before the trees are read: the storage from the grids' metadata (their stored boxes and
+  // OpenVDB's in-memory sizes), and the sparse memory estimate against the limit.
+  void plan_from_metadata(const std::vector<openvdb::GridBase::Ptr>& metas, const std::vector<Used>& used) {
+    CoordBBox box;
+    double trees = 0;
+    for (const auto& meta : metas) {
+      if (!meta) return;
+      const auto lo = meta->getMetadata<openvdb::Vec3IMetadata>("file_bbox_min");
+      const auto hi = meta->getMetadata<openvdb::Vec3IMetadata>("file_bbox_max");
+      const auto mem = meta->getMetadata<openvdb::Int64Metadata>("file_mem_bytes");
+      if (!lo || !hi || !mem) return;  // decided once the trees are read
+      const Coord a(lo->value()), b(hi->value());
+      if (a.x() <= b.x() && a.y() <= b.y() && a.z() <= b.z()) box.expand(CoordBBox(a, b));
+      trees += double(std::max<int64_t>(0, mem->value()));
+    }
+    if (box.empty()) return;
+    double dim[3];
+    for (int a = 0; a < 3; ++a) dim[a] = double(int64_t(box.max()[a]) - int64_t(box.min()[a]) + 1);
+    if (storage_ == Storage::Auto) storage_ = choose_from(dim, used.size(), trees);
+    if (storage_ != Storage::Sparse) return;
+    check_sparse_box(box.min(), box.max(), "grids' stored ");
+    const double need = trees + sparse_index_estimate(dim, trees, trilinear());
+    check_sparse_memory(need, "about ", "OpenVDB trees " + fmt_mib(trees) + " + index");
+  }
+
+  static std::string fmt_mib(double bytes) { return fmt(bytes / double(1ull << 20)) + " MiB"; }
+
+  void check_sparse_memory(double need, const std::string& about, const std::string& parts) const {
+    const double limit = double(desc_.max_sparse_bytes);
+    if (need > limit)
+      fail_file("the sparse grids need " + about + fmt_mib(need) + " (" + parts + "), above the limit of " +
+                fmt_mib(limit) + " left by --max-memory (docs/volumes.md, Limits)");
+  }
+
+  // Sparse field coordinates are int: each edge of the box, from its node-aligned start, must
+  // stay below 2^30 voxels.
+  void check_sparse_box(const Coord& lo, const Coord& hi, const std::string& what) const {
+    for (int a = 0; a < 3; ++a) {
+      const int64_t start = (int64_t(lo[a]) >> SparseField::kNodeLog2) * SparseField::kNode;
+      if (int64_t(hi[a]) - start + 1 > (int64_t(1) << 30))
+        fail_file("the " + what + "box " + fmt(lo) + " to " + fmt(hi) + " is " +
+                  std::to_string(int64_t(hi[a]) - int64_t(lo[a]) + 1) + " voxels along axis " +
+                  std::string(1, char('x' + a)) + ", above the limit of 2^30 (docs/volumes.md, Limits)");
+    }
+  }
+
+  // Keeps the trees: builds the sparse field over their leaves and records the value ranges.
+  void make_sparse(VolumeData& out, std::vector<Used>& used, const CoordBBox& box) const {
+    std::vector<SparseGridInput> in;
+    for (const Used& u : used) {
+      SparseGridInput s;
+      s.role = u.role == Role::Density  ? SparseGridInput::Role::Density
+               : u.role == Role::Albedo ? SparseGridInput::Role::Albedo
+                                        : SparseGridInput::Role::Eta;
+      s.grid = u.grid;
+      s.fill = u.fill;
+      in.push_back(s);
+    }
+    const auto check = [&](const SparseGridInput& s, const Coord& c, float x) {
+      const Used& u = used[std::size_t(&s - in.data())];
+      if (const std::string p = value_problem(u.role, x); !p.empty())
+        fail(u, "grid '" + clip(u.name) + "' voxel " + fmt(c) + ": " + p + " (got " + fmt(x) + ")");
+    };
+    std::shared_ptr<SparseField> f;
+    try {
+      f = build_sparse_field(in, box, trilinear(), desc_.sigma_t_scale, static_cast<float>(desc_.albedo),
+                             static_cast<float>(desc_.eta), check);
+    } catch (const std::bad_alloc&) {
+      fail_file("not enough memory for the sparse index of the grids");
+    }
+    check_sparse_memory(double(f->tree_bytes + f->index_bytes()), "",
+                        "OpenVDB trees " + fmt_mib(double(f->tree_bytes)) + " + index " +
+                            fmt_mib(double(f->index_bytes())));
+    uint64_t cells = 1;
+    for (int a = 0; a < 3; ++a) cells *= uint64_t(f->hi[a] - f->lo[a]);
+    for (std::size_t i = 0; i < used.size(); ++i) {
+      DenseGrid& d = *used[i].dense;
+      d.nx = f->hi[0] - f->lo[0];
+      d.ny = f->hi[1] - f->lo[1];
+      d.nz = f->hi[2] - f->lo[2];
+      // Inactive voxels in the box take the fill value.
+      const bool gaps = used[i].grid->activeVoxelCount() < cells;
+      const bool any = in[i].min_active <= in[i].max_active && used[i].grid->activeVoxelCount() > 0;
+      d.min_value = any ? (gaps ? std::min(in[i].min_active, used[i].fill) : in[i].min_active) : used[i].fill;
+      d.max_value = any ? (gaps ? std::max(in[i].max_active, used[i].fill) : in[i].max_active) : used[i].fill;
+    }
+    out.sparse = std::move(f);
+  }
 
   [[noreturn]] void fail_at(const std::string& key, const std::string& problem) const {
     throw InputError(prefix_ + key + ": " + clip(desc_.file, 200) + ": " + problem);
@@ -175,12 +314,15 @@ class VolumeLoader {
   }
 
   // Every failure inside OpenVDB's reader, including running out of memory, is bad input.
-  void read_grids(std::vector<Used>& used) const {
+  void read_grids(std::vector<Used>& used) {
     try {
       openvdb::io::File file(desc_.file);
       file.open(/*delayLoad=*/false);
       const openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();
-      for (Used& u : used) u.grid = read_grid(file, *metas, u, used.size());
+      std::vector<openvdb::GridBase::Ptr> mine;
+      for (const Used& u : used) mine.push_back(find_meta(*metas, u));
+      plan_from_metadata(mine, used);
+      for (std::size_t i = 0; i < used.size(); ++i) used[i].grid = read_grid(file, *mine[i], used[i], used.size());
       file.close();
     } catch (const InputError&) {
       throw;
@@ -237,8 +379,8 @@ class VolumeLoader {
     check_box(a, b, grids, "grid '" + clip(meta.getName()) + "' ");
   }
 
-  FloatGrid::Ptr read_grid(openvdb::io::File& file, const openvdb::GridPtrVec& metas,
-                           const Used& u, std::size_t grids) const {
+  // The grid's metadata, checked: it exists, holds floats, has a usable class and transform.
+  openvdb::GridBase::Ptr find_meta(const openvdb::GridPtrVec& metas, const Used& u) const {
     openvdb::GridBase::Ptr meta;
     std::string available;
     for (const auto& g : metas) {
@@ -253,7 +395,9 @@ class VolumeLoader {
                   (available.empty() ? std::string("no grids") : clip(available, 400)));
     if (!meta->isType<FloatGrid>())
       fail(u, grid + " holds " + clip(meta->valueType()) + " values (" + clip(meta->type()) +
-                  "); femto needs a FloatGrid (float values)");
+                  "); femto needs a FloatGrid (float values)" +
+                  (meta->valueType().rfind("vec", 0) == 0 ? "; vector grids such as velocity are not supported"
+                                                          : ""));
     const openvdb::GridClass cls = meta->getGridClass();
     if (u.role == Role::Density && cls == openvdb::GRID_LEVEL_SET)
       fail(u, grid +
@@ -264,7 +408,12 @@ class VolumeLoader {
     if (!meta->transform().isLinear())
       fail(u, grid + " has a non-linear transform (" + meta->transform().mapType() +
                   "); only affine (linear) transforms are supported");
-    check_metadata_box(*meta, grids);
+    return meta;
+  }
+
+  FloatGrid::Ptr read_grid(openvdb::io::File& file, const openvdb::GridBase& meta, const Used& u,
+                           std::size_t grids) const {
+    if (storage_ != Storage::Sparse) check_metadata_box(meta, grids);
     return openvdb::gridPtrCast<FloatGrid>(file.readGrid(u.name));
   }
 
@@ -412,8 +561,9 @@ void write_vdb(const std::string& path, const std::vector<VdbGridSpec>& grids) {
   for (const VdbGridSpec& s : grids) {
     if ((!s.values || s.values->empty()) && s.voxels.empty())
       throw RuntimeError("write_vdb: grid '" + s.name + "' is empty");
-    openvdb::GridBase::Ptr g = s.type == VdbGridSpec::Type::Float ? make_grid<FloatGrid>(s)
-                                                                  : make_grid<openvdb::DoubleGrid>(s);
+    openvdb::GridBase::Ptr g = s.type == VdbGridSpec::Type::Float    ? make_grid<FloatGrid>(s)
+                               : s.type == VdbGridSpec::Type::Double ? make_grid<openvdb::DoubleGrid>(s)
+                                                                     : make_grid<openvdb::Vec3SGrid>(s);
     g->setName(s.name);
     g->setGridClass(s.grid_class == VdbGridSpec::Class::LevelSet    ? openvdb::GRID_LEVEL_SET
                     : s.grid_class == VdbGridSpec::Class::FogVolume ? openvdb::GRID_FOG_VOLUME

@@ -4,12 +4,14 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/scene_desc.h"
 #include "core/vec3.h"
+#include "media/sparse_field.h"
 
 namespace femto {
 
@@ -45,6 +47,9 @@ struct VolumeData {
   double voxel_size[3] = {};  ///< world length of one cell edge along each grid axis, mm
   int index_min[3] = {};      ///< VDB index coordinate of dense cell (0,0,0) (for messages)
   uint64_t active_voxels = 0;  ///< active voxels of the density grid in the file
+  /// Sparse storage (docs/volumes.md): then density, albedo and eta hold only their shape
+  /// (nx, ny, nz) and value ranges, with no values.
+  std::shared_ptr<const SparseField> sparse;
 
   uint64_t memory_bytes() const;
   Vec3 to_world(const Vec3& g) const;  ///< grid space -> world (mm)
@@ -72,7 +77,7 @@ void write_volume(const std::string& path, const DenseGrid& density, const Dense
 
 /// One grid for write_vdb with full control, including deliberately invalid files for tests.
 struct VdbGridSpec {
-  enum class Type { Float, Double };                       ///< Double: a wrong type, for tests
+  enum class Type { Float, Double, Vec3 };  ///< Double, Vec3 (x, x, x): wrong types, for tests
   enum class Class { Unknown, FogVolume, LevelSet };
   std::string name;
   const DenseGrid* values = nullptr;  ///< cells equal to `background` stay inactive

@@ -40,6 +40,7 @@ std::string load_error(const std::string& file, uint64_t max_bytes = 16ull << 30
   VdbMediumDesc d;
   d.file = file;
   d.max_dense_bytes = max_bytes;
+  d.storage = VdbMediumDesc::Storage::Dense;  // the dense limits (auto would keep these sparse)
   try {
     load_volume(d, "scene.json", "/media/m");
   } catch (const InputError& e) {

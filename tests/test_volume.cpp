@@ -249,6 +249,7 @@ TEST_CASE("bad volumes: transforms, backgrounds, non-finite values, sizes", "[vd
     e.index_offset = {2000, 2000, 1000};
     e.origin_mm = e.index_offset;  // same transform as the density grid (voxel 1 mm)
     write({grid_spec("density", DenseGrid(1, 1, 1, 1.0f)), e});
+    d.storage = VdbMediumDesc::Storage::Dense;  // the dense limit (auto keeps this sparse)
     CHECK_THAT(load_error(d), Catch::Contains("2001 x 2001 x 1001") && Catch::Contains("2^30"));
   }
   SECTION("dense grids above the memory left by --max-memory") {
@@ -258,6 +259,7 @@ TEST_CASE("bad volumes: transforms, backgrounds, non-finite values, sizes", "[vd
     write({grid_spec("density", one), a, e});
     d.albedo_grid = "albedo";
     d.max_dense_bytes = 16ull << 20;
+    d.storage = VdbMediumDesc::Storage::Dense;  // the dense limit (auto keeps this sparse)
     CHECK_THAT(load_error(d), Catch::Contains("128 x 128 x 128") && Catch::Contains("24 MiB") &&
                                   Catch::Contains("--max-memory"));
   }
