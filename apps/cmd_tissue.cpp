@@ -45,7 +45,8 @@ const char* kTissueHelp =
     "\n"
     "Outputs: fluence.npy (X,Y,Z,T float32, 1/mm^2 per gate per unit launched energy),\n"
     "fluence_rate.npy (1/(mm^2 ps)), fluence.nii, fluence_stderr.npy (on request), tpsf.npy and\n"
-    "tpsf.csv (1/(mm^2 ps)), detected_photons.npy and detected_ppath.npy, exitance_*.npy (faces),\n"
+    "tpsf.csv (1/(mm^2 ps)), detected_photons.npy, detected_ppath.npy, detected_exit.npy,\n"
+    "exitance_*.npy (faces),\n"
     "summary.json (energy balance, absorbed fraction) and render.json.\n";
 
 int cmd_tissue(const std::vector<std::string>& argv, const std::string& command_line) {

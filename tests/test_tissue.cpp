@@ -92,6 +92,7 @@ TEST_CASE("tissue outputs are bit-identical for any thread count", "[tissue]") {
   CHECK(a.face_exitance == b.face_exitance);
   CHECK(a.detected.weight == b.detected.weight);
   CHECK(a.detected.ppath == b.detected.ppath);
+  CHECK(a.detected.exit == b.detected.exit);
   CHECK(a.balance.absorbed == b.balance.absorbed);
   CHECK(a.balance.alive == b.balance.alive);
   REQUIRE(a.detected.size() > 10);
@@ -352,8 +353,8 @@ TEST_CASE("femto render runs a tissue scene and writes the documented outputs", 
   INFO(run.err);
   REQUIRE(run.code == 0);
   for (const char* f : {"fluence.npy", "fluence_rate.npy", "fluence.nii", "tpsf.npy", "tpsf.csv",
-                        "detected_photons.npy", "detected_ppath.npy", "exitance_zmin.npy",
-                        "summary.json", "render.json"})
+                        "detected_photons.npy", "detected_ppath.npy", "detected_exit.npy",
+                        "exitance_zmin.npy", "summary.json", "render.json"})
     CHECK(fs::exists(tmp.dir / "out" / f));
   std::vector<size_t> shape;
   std::vector<float> fl;
@@ -553,6 +554,24 @@ TEST_CASE("detector numerical aperture selects the exit cone", "[tissue]") {
   // The second detector sees the rest of the face (a photon counts for the first detector only).
   CHECK(r.detected_weight[0] + r.detected_weight[1] ==
         Approx(r.balance.escaped_faces[4]).epsilon(1e-12));
+  // Catches exit records taken before the photon reaches the face, or from another photon: every
+  // detected photon's exit point lies on the z = 0 face within its detector's disc, its direction
+  // leaves through that face, and the first detector's directions lie within the NA's cone.
+  const DetectedPhotons& d = r.detected;
+  REQUIRE(d.exit.size() == 6 * d.size());
+  REQUIRE(d.size() > 1000);
+  for (size_t i = 0; i < d.size(); ++i) {
+    const double* e = &d.exit[6 * i];
+    CHECK(std::abs(e[2]) < 1e-9);
+    CHECK(std::hypot(e[0] - 20, e[1] - 20) <= 30.0);
+    CHECK(e[5] < 0);
+    CHECK(std::hypot(e[3], e[4], e[5]) == Approx(1.0).epsilon(1e-12));
+    if (d.detector[i] == 0) CHECK(-e[5] >= std::cos(kPi / 6) - 1e-12);
+    // The exit point is where the straight flight from the source meets the face (no scattering).
+    const double flight = -1.0 / e[5];
+    CHECK(e[0] - flight * e[3] == Approx(20.3).margin(1e-9));
+    CHECK(e[1] - flight * e[4] == Approx(19.8).margin(1e-9));
+  }
 }
 
 // Catches a spot source that does not follow the camera scenes' spot light: without falloff

@@ -145,6 +145,8 @@ std::vector<std::string> write_outputs(const std::string& dir, const Setup& s, c
       }
       write_npy_float32(path("detected_photons.npy"), {n, 4}, info.data());
       write_npy_float32(path("detected_ppath.npy"), {n, L}, pp.data());
+      const std::vector<float> exit(dp.exit.begin(), dp.exit.end());
+      write_npy_float32(path("detected_exit.npy"), {n, 6}, exit.data());
     }
   }
   if (s.faces)

@@ -83,6 +83,7 @@ void write_chunk(distributed::ByteWriter& w, const ChunkSums& c) {
   w.put_vector(r.weight);
   w.put_vector(r.time_ps);
   w.put_vector(r.ppath);
+  w.put_vector(r.exit);
   w.put(r.dropped);
   w.put(c.scatterings);
   w.put(c.segments);
@@ -99,6 +100,7 @@ void read_chunk(distributed::ByteReader& in, ChunkSums& c) {
   r.weight = in.get_vector<double>();
   r.time_ps = in.get_vector<double>();
   r.ppath = in.get_vector<double>();
+  r.exit = in.get_vector<double>();
   r.dropped = in.get<uint64_t>();
   c.scatterings = in.get<uint64_t>();
   c.segments = in.get<uint64_t>();
@@ -344,6 +346,7 @@ class Tally {
       rec.weight.push_back(p.w);
       rec.time_ps.push_back(p.t);
       rec.ppath.insert(rec.ppath.end(), ppath_.begin() + 1, ppath_.end());
+      rec.exit.insert(rec.exit.end(), {p.x.x, p.x.y, p.x.z, p.d.x, p.d.y, p.d.z});
       return;  // a photon counts for the first detector it reaches
     }
   }
@@ -690,6 +693,8 @@ Result simulate(const Setup& s) {
         const size_t w = static_cast<size_t>(R.labels);
         R.ppath.insert(R.ppath.end(), cr.ppath.begin() + static_cast<std::ptrdiff_t>(i * w),
                        cr.ppath.begin() + static_cast<std::ptrdiff_t>((i + 1) * w));
+        R.exit.insert(R.exit.end(), cr.exit.begin() + static_cast<std::ptrdiff_t>(6 * i),
+                      cr.exit.begin() + static_cast<std::ptrdiff_t>(6 * i + 6));
       }
     }
     for (size_t i = 0; i < tpsf_size; ++i) {

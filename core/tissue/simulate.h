@@ -33,6 +33,9 @@ struct DetectedPhotons {
   std::vector<int32_t> detector, scatterings;
   std::vector<double> weight, time_ps;  ///< exit weight (launch weight 1) and exit time
   std::vector<double> ppath;  ///< row-major (photon, label - 1): path length per label, mm
+  /// Row-major (photon, 6): exit point x, y, z (mm, on the detector's face) and the direction
+  /// leaving the volume (after refraction), the inputs of a fibre or lens model.
+  std::vector<double> exit;
   uint64_t dropped = 0;       ///< detected beyond max_detected (counted in the TPSF)
   size_t size() const { return weight.size(); }
 };
