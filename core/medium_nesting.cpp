@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "core/error.h"
 
@@ -144,10 +146,70 @@ Relation sphere_triangles(const ShapeDesc& a, const ShapeDesc& b, bool b_closed,
   return Relation::Touch;
 }
 
+// The triangles of a shape binned into a uniform grid over its bounds, so that the pair tests
+// below look only at triangles near an edge or a vertex (large nested meshes stay fast).
+class TriangleGrid {
+ public:
+  TriangleGrid(const ShapeDesc& s, double tol) : shape_(s), tol_(tol) {
+    for (const Vec3& v : s.vertices) box_.add(v);
+    const size_t T = s.triangles.size();
+    r_ = std::clamp(static_cast<int>(std::cbrt(static_cast<double>(T))), 1, 64);
+    for (int a = 0; a < 3; ++a) {
+      const double extent = std::max(box_.hi[a] - box_.lo[a], 1e-300);
+      inv_cell_[a] = r_ / extent;
+    }
+    cells_.resize(static_cast<size_t>(r_) * r_ * r_);
+    boxes_.resize(T);
+    for (size_t j = 0; j < T; ++j) {
+      boxes_[j] = bounds_of(triangle(s, j));
+      for_cells(boxes_[j], [&](size_t c) { cells_[c].push_back(static_cast<uint32_t>(j)); });
+    }
+    stamp_.assign(T, 0);
+  }
+  double tolerance() const { return tol_; }
+  /// Calls f(j, triangle j) once for every triangle whose box comes within tol of q.
+  template <class F>
+  bool any(const Box3& q, F f) {
+    if (!q.overlaps(box_, tol_)) return false;
+    ++visit_;
+    bool hit = false;
+    for_cells(q, [&](size_t c) {
+      for (uint32_t j : cells_[c]) {
+        if (hit || stamp_[j] == visit_) continue;
+        stamp_[j] = visit_;
+        if (q.overlaps(boxes_[j], tol_) && f(triangle(shape_, j))) hit = true;
+      }
+    });
+    return hit;
+  }
+
+ private:
+  int cell(double x, int a) const {
+    return std::clamp(static_cast<int>(std::floor((x - box_.lo[a]) * inv_cell_[a])), 0, r_ - 1);
+  }
+  template <class F>
+  void for_cells(const Box3& q, F f) const {
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) lo[a] = cell(q.lo[a] - tol_, a), hi[a] = cell(q.hi[a] + tol_, a);
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x)
+          f((static_cast<size_t>(z) * r_ + static_cast<size_t>(y)) * r_ + static_cast<size_t>(x));
+  }
+
+  const ShapeDesc& shape_;
+  double tol_;
+  Box3 box_;
+  int r_ = 1;
+  double inv_cell_[3] = {1, 1, 1};
+  std::vector<std::vector<uint32_t>> cells_;
+  std::vector<Box3> boxes_;
+  std::vector<uint32_t> stamp_;
+  uint32_t visit_ = 0;
+};
+
 // Whether an edge of a crosses a triangle of b strictly inside both.
-bool edges_cross(const ShapeDesc& a, const ShapeDesc& b, const Box3& b_box, double tol) {
-  std::vector<Box3> boxes(b.triangles.size());
-  for (size_t j = 0; j < b.triangles.size(); ++j) boxes[j] = bounds_of(triangle(b, j));
+bool edges_cross(const ShapeDesc& a, TriangleGrid& b) {
   for (size_t i = 0; i < a.triangles.size(); ++i) {
     const Tri t = triangle(a, i);
     const Vec3 corners[3] = {t.a, t.b, t.c};
@@ -155,23 +217,26 @@ bool edges_cross(const ShapeDesc& a, const ShapeDesc& b, const Box3& b_box, doub
       const Vec3 p0 = corners[e], p1 = corners[(e + 1) % 3];
       Box3 eb;
       eb.add(p0), eb.add(p1);
-      if (!eb.overlaps(b_box, tol)) continue;
-      const double len = length(p1 - p0);
-      const double s_tol = tol / std::max(len, 1e-300);
-      for (size_t j = 0; j < b.triangles.size(); ++j) {
-        if (!eb.overlaps(boxes[j], tol)) continue;
-        const double s = crossing(p0, p1 - p0, triangle(b, j), 1e-9);
-        if (s > s_tol && s < 1 - s_tol) return true;
-      }
+      const double s_tol = b.tolerance() / std::max(length(p1 - p0), 1e-300);
+      if (b.any(eb, [&](const Tri& tb) {
+            const double s = crossing(p0, p1 - p0, tb, 1e-9);
+            return s > s_tol && s < 1 - s_tol;
+          }))
+        return true;
     }
   }
   return false;
 }
 
 // Whether a vertex of a lies within tol of b's surface.
-bool vertex_on_surface(const ShapeDesc& a, const ShapeDesc& b, const Box3& b_box, double tol) {
-  for (const Vec3& v : a.vertices)
-    if (b_box.holds(v, tol) && distance_to_triangles(b, v) <= tol) return true;
+bool vertex_on_surface(const ShapeDesc& a, TriangleGrid& b) {
+  const double tol = b.tolerance();
+  for (const Vec3& v : a.vertices) {
+    Box3 q;
+    q.add(v);
+    if (b.any(q, [&](const Tri& tb) { return length(v - closest_on_triangle(v, tb)) <= tol; }))
+      return true;
+  }
   return false;
 }
 
@@ -181,10 +246,9 @@ Relation relate(const ShapeDesc& a, bool a_closed, const ShapeDesc& b, bool b_cl
   if (is_sphere(a) && is_sphere(b)) return spheres(a, b, tol);
   if (is_sphere(a)) return sphere_triangles(a, b, b_closed, tol);
   if (is_sphere(b)) return flip(sphere_triangles(b, a, a_closed, tol));
-  const Box3 a_box = bounds_of(a), b_box = bounds_of(b);
-  if (edges_cross(a, b, b_box, tol) || edges_cross(b, a, a_box, tol)) return Relation::Cross;
-  if (vertex_on_surface(a, b, b_box, tol) || vertex_on_surface(b, a, a_box, tol))
-    return Relation::Touch;
+  TriangleGrid a_grid(a, tol), b_grid(b, tol);
+  if (edges_cross(a, b_grid) || edges_cross(b, a_grid)) return Relation::Cross;
+  if (vertex_on_surface(a, b_grid) || vertex_on_surface(b, a_grid)) return Relation::Touch;
   if (b_closed && inside(b, a.vertices.front())) return Relation::AInB;
   if (a_closed && inside(a, b.vertices.front())) return Relation::BInA;
   return Relation::Disjoint;
