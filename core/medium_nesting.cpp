@@ -155,8 +155,8 @@ class TriangleGrid {
     const size_t T = s.triangles.size();
     r_ = std::clamp(static_cast<int>(std::cbrt(static_cast<double>(T))), 1, 64);
     for (int a = 0; a < 3; ++a) {
-      const double extent = std::max(box_.hi[a] - box_.lo[a], 1e-300);
-      inv_cell_[a] = r_ / extent;
+      const double extent = box_.hi[a] - box_.lo[a];
+      inv_cell_[a] = extent > 0 ? r_ / extent : 0.0;  // a flat shape: one layer of cells
     }
     cells_.resize(static_cast<size_t>(r_) * r_ * r_);
     boxes_.resize(T);
@@ -184,8 +184,9 @@ class TriangleGrid {
   }
 
  private:
-  int cell(double x, int a) const {
-    return std::clamp(static_cast<int>(std::floor((x - box_.lo[a]) * inv_cell_[a])), 0, r_ - 1);
+  int cell(double x, int a) const {  // clamped as a double: x may lie far outside the box
+    const double c = std::floor((x - box_.lo[a]) * inv_cell_[a]);
+    return static_cast<int>(std::clamp(c, 0.0, static_cast<double>(r_ - 1)));
   }
   template <class F>
   void for_cells(const Box3& q, F f) const {
