@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "core/render.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -20,12 +21,10 @@
 #include "samplers/medium_distance.h"
 
 using namespace femto;
+using bench::now_s;
+using bench::walk_rate;
 
 namespace {
-
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 VolumeData volume_from(const GeneratedVolume& g, double voxel) {
   VolumeData v{};
@@ -38,30 +37,6 @@ VolumeData volume_from(const GeneratedVolume& g, double voxel) {
   return v;
 }
 
-// Random walk of `walks` photons from the centre until they leave the box [-half, half]^3:
-// returns collision events per second. Segments come from `make_segments(ray, s_exit)`.
-template <class MakeSegments>
-double walk_rate(int walks, double half, MakeSegments make_segments, uint64_t& events) {
-  events = 0;
-  const DistanceStrategy mfp{DistanceSampling::Mfp, 0, MisHeuristic::Balance};
-  const double t0 = now_s();
-  for (int w = 0; w < walks; ++w) {
-    Rng rng(7, static_cast<uint64_t>(w));
-    Vec3 x(0, 0, 0);
-    for (int step = 0; step < 100000; ++step) {
-      const Vec3 d = sample_uniform_sphere(rng.uniform(), rng.uniform());
-      double s_exit = 1e30;  // distance to the box boundary
-      for (int a = 0; a < 3; ++a)
-        if (d[a] != 0) s_exit = std::min(s_exit, ((d[a] > 0 ? half : -half) - x[a]) / d[a]);
-      auto segments = make_segments(Ray{x, d}, s_exit);
-      const DistanceEvent ev = sample_distance(segments, mfp, rng.uniform());
-      if (!ev.collided) break;
-      ++events;
-      x = x + d * ev.s;
-    }
-  }
-  return static_cast<double>(events) / (now_s() - t0);
-}
 
 void tracking(int n) {
   const double voxel = 1.0, half = 0.5 * n * voxel;

@@ -32,13 +32,11 @@
 #include "samplers/medium_distance.h"
 
 using namespace femto;
+using bench::now_s;
 namespace fs = std::filesystem;
 
 namespace {
 
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 std::string temp_file(const std::string& name) {
   return (fs::temp_directory_path() /
@@ -46,28 +44,10 @@ std::string temp_file(const std::string& name) {
       .string();
 }
 
-// femto-bench-media's walk: photons from the centre of the box [-half, half]^3 until they leave;
-// collision events per second.
+// femto-bench-media's walk through a voxel medium.
 double walk_rate(const GridMedium& grid, int walks, double half, uint64_t& events) {
-  events = 0;
-  const DistanceStrategy mfp{DistanceSampling::Mfp, 0, MisHeuristic::Balance};
-  const double t0 = now_s();
-  for (int w = 0; w < walks; ++w) {
-    Rng rng(7, static_cast<uint64_t>(w));
-    Vec3 x(0, 0, 0);
-    for (int step = 0; step < 100000; ++step) {
-      const Vec3 d = sample_uniform_sphere(rng.uniform(), rng.uniform());
-      double s_exit = 1e30;
-      for (int a = 0; a < 3; ++a)
-        if (d[a] != 0) s_exit = std::min(s_exit, ((d[a] > 0 ? half : -half) - x[a]) / d[a]);
-      GridMedium::Walker segments(grid, Ray{x, d}, s_exit);
-      const DistanceEvent ev = sample_distance(segments, mfp, rng.uniform());
-      if (!ev.collided) break;
-      ++events;
-      x = x + d * ev.s;
-    }
-  }
-  return static_cast<double>(events) / (now_s() - t0);
+  return bench::walk_rate(
+      walks, half, [&](const Ray& r, double s) { return GridMedium::Walker(grid, r, s); }, events);
 }
 
 struct Loaded {

@@ -1,9 +1,16 @@
 #pragma once
-// Small helpers shared by the benchmark programs: the machine they ran on, and medians.
+// Small helpers shared by the benchmark programs: the machine they ran on, medians, a clock and
+// the random walk that the medium benchmarks time.
 #include <algorithm>
+#include <chrono>
+#include <cstdint>
 #include <fstream>
 #include <string>
 #include <vector>
+
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "samplers/medium_distance.h"
 
 namespace femto::bench {
 
@@ -21,6 +28,36 @@ inline double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
+}
+
+/// Seconds on a steady clock.
+inline double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Random walk of `walks` photons from the centre until they leave the box [-half, half]^3:
+// returns collision events per second. Segments come from `make_segments(ray, s_exit)`.
+template <class MakeSegments>
+inline double walk_rate(int walks, double half, MakeSegments make_segments, uint64_t& events) {
+  events = 0;
+  const DistanceStrategy mfp{DistanceSampling::Mfp, 0, MisHeuristic::Balance};
+  const double t0 = now_s();
+  for (int w = 0; w < walks; ++w) {
+    Rng rng(7, static_cast<uint64_t>(w));
+    Vec3 x(0, 0, 0);
+    for (int step = 0; step < 100000; ++step) {
+      const Vec3 d = sample_uniform_sphere(rng.uniform(), rng.uniform());
+      double s_exit = 1e30;  // distance to the box boundary
+      for (int a = 0; a < 3; ++a)
+        if (d[a] != 0) s_exit = std::min(s_exit, ((d[a] > 0 ? half : -half) - x[a]) / d[a]);
+      auto segments = make_segments(Ray{x, d}, s_exit);
+      const DistanceEvent ev = sample_distance(segments, mfp, rng.uniform());
+      if (!ev.collided) break;
+      ++events;
+      x = x + d * ev.s;
+    }
+  }
+  return static_cast<double>(events) / (now_s() - t0);
 }
 
 }  // namespace femto::bench

@@ -17,6 +17,26 @@ inline ShapeDesc quad(const Vec3& corner, const Vec3& e1, const Vec3& e2, const 
   return s;
 }
 
+/// A perspective camera at pos looking at `look_at`, vertical field of view fov degrees.
+inline CameraDesc perspective(const Vec3& pos, const Vec3& look_at, double fov, int w, int h) {
+  CameraDesc c;
+  c.type = CameraDesc::Type::Perspective;
+  c.position = pos;
+  c.look_at = look_at;
+  c.fov_deg = fov;
+  c.width = w;
+  c.height = h;
+  return c;
+}
+
+inline LightDesc point_light(const Vec3& p, double intensity) {
+  LightDesc l;
+  l.type = LightDesc::Type::Point;
+  l.position = p;
+  l.intensity = RGB(intensity);
+  return l;
+}
+
 inline MaterialDesc diffuse(double albedo) {
   MaterialDesc m;
   m.type = MaterialDesc::Type::Diffuse;

@@ -21,17 +21,6 @@ using namespace femto::test;
 
 namespace {
 
-CameraDesc perspective(const Vec3& pos, const Vec3& look_at, double fov, int w, int h) {
-  CameraDesc c;
-  c.type = CameraDesc::Type::Perspective;
-  c.position = pos;
-  c.look_at = look_at;
-  c.fov_deg = fov;
-  c.width = w;
-  c.height = h;
-  return c;
-}
-
 MaterialDesc glass(double eta) {
   MaterialDesc m;
   m.type = MaterialDesc::Type::Dielectric;
@@ -46,14 +35,6 @@ ShapeDesc sphere(const Vec3& c, double r, const MaterialDesc& m) {
   s.radius = r;
   s.material = m;
   return s;
-}
-
-LightDesc point_light(const Vec3& p, double intensity) {
-  LightDesc l;
-  l.type = LightDesc::Type::Point;
-  l.position = p;
-  l.intensity = RGB(intensity);
-  return l;
 }
 
 /// A point light beside and above a glass sphere over a diffuse floor; the orthographic camera

@@ -113,25 +113,6 @@ Ray random_ray(Rng& rng, const Vec3& lo, const Vec3& hi, double& s_max) {
   return Ray{o, normalize(t - o)};
 }
 
-CameraDesc perspective(const Vec3& pos, const Vec3& at, double fov, int w, int h) {
-  CameraDesc c;
-  c.type = CameraDesc::Type::Perspective;
-  c.position = pos;
-  c.look_at = at;
-  c.fov_deg = fov;
-  c.width = w;
-  c.height = h;
-  return c;
-}
-
-LightDesc point_light(const Vec3& p, double intensity) {
-  LightDesc l;
-  l.type = LightDesc::Type::Point;
-  l.position = p;
-  l.intensity = RGB(intensity);
-  return l;
-}
-
 TimeAxis axis_of(double t0, double width, int bins) {
   TimeAxis a;
   a.t_start_ps = t0;
