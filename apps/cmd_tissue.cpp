@@ -112,7 +112,7 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
         path + ": the run needs " + cli::format_bytes(need) + " (fluence volume " +
         std::to_string(s.fluence_grid.n[0]) + " x " + std::to_string(s.fluence_grid.n[1]) + " x " +
         std::to_string(s.fluence_grid.n[2]) + " x " + std::to_string(s.time.bins) +
-        " gates, summed per thread, and the label volume), more than --max-memory " +
+        " gates, summed per thread, and the tissue volume), more than --max-memory " +
         cli::format_bytes(max_memory) +
         ": lower /tissue/fluence/resolution or /tissue/time/bins, or raise --max-memory");
   // The output folder is checked before the run (a foreign folder is bad input).
@@ -131,11 +131,14 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
   if (!quiet)
     std::fprintf(
         stderr,
-        "femto tissue: %s: %d x %d x %d voxels of %g mm, %zu labels, %s boundary; %llu photons, "
-        "%d gates of %g ps; memory: fluence volume %s x %d threads + sums, label volume %s, "
+        "femto tissue: %s: %d x %d x %d voxels of %g mm, %s, %s boundary; %llu photons, "
+        "%d gates of %g ps; memory: fluence volume %s x %d threads + sums, tissue volume %s, "
         "total %s\n",
         path.c_str(), s.volume.n[0], s.volume.n[1], s.volume.n[2], s.volume.voxel,
-        s.volume.optics.size() - 1, s.fresnel ? "Fresnel" : "index-matched",
+        s.volume.voxel_optics.empty()
+            ? (std::to_string(s.volume.optics.size() - 1) + " labels").c_str()
+            : "optics per voxel",
+        s.fresnel ? "Fresnel" : "index-matched",
         static_cast<unsigned long long>(s.photons), s.time.bins, s.time.bin_width_ps,
         cli::format_bytes(fluence_bytes).c_str(), threads,
         cli::format_bytes(s.volume.memory_bytes()).c_str(), cli::format_bytes(need).c_str());

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/io/nifti.h"
 #include "media/label_grid_vdb.h"
+#include "media/volume_data.h"
 
 namespace femto::tissue {
 
@@ -251,6 +252,73 @@ void read_labels(const Reader& rd, const Json& j, const std::string& P, double o
                      " occurs in the volume but has no optical properties here");
 }
 
+// A voxel medium (OpenVDB density/albedo/eta grids, the keys of a camera scene's "vdb" medium)
+// as the tissue: each voxel gets its own mu_a, mu_s and n; every voxel has label 1.
+void read_medium(const Reader& rd, const Json& j, const std::string& P, double outside_n,
+                 const std::string& source, Setup& s) {
+  rd.object(j, P,
+            {"type", "file", "density_grid", "sigma_t_scale", "albedo", "albedo_grid", "eta",
+             "eta_grid", "g", "interpolation"});
+  if (j.contains("type")) rd.string(j["type"], P + "/type", {"vdb"});
+  for (const char* k : {"file", "sigma_t_scale"})
+    if (!j.contains(k)) rd.fail(P + "/" + k, "required");
+  VdbMediumDesc d;
+  d.file = rd.file(j["file"], P + "/file");
+  if (j.contains("density_grid")) d.density_grid = rd.string(j["density_grid"], P + "/density_grid");
+  d.sigma_t_scale = rd.number(j["sigma_t_scale"], P + "/sigma_t_scale", 0, 1e6, true);
+  if (j.contains("albedo") && j.contains("albedo_grid"))
+    rd.fail(P + "/albedo", "give \"albedo\" or \"albedo_grid\", not both");
+  if (j.contains("albedo")) d.albedo = rd.number(j["albedo"], P + "/albedo", 0, 1);
+  if (j.contains("albedo_grid")) d.albedo_grid = rd.string(j["albedo_grid"], P + "/albedo_grid");
+  if (j.contains("eta")) d.eta = rd.number(j["eta"], P + "/eta", 1, 10);
+  if (j.contains("eta_grid")) d.eta_grid = rd.string(j["eta_grid"], P + "/eta_grid");
+  const double g = j.contains("g") ? rd.number(j["g"], P + "/g", -1, 1, true, true) : 0.0;
+  if (j.contains("interpolation") &&
+      rd.string(j["interpolation"], P + "/interpolation", {"nearest", "trilinear"}) != "nearest")
+    rd.fail(P + "/interpolation",
+            "tissue volumes are voxel-constant: only \"nearest\" applies here", j["interpolation"]);
+  d.interpolation = VdbMediumDesc::Interpolation::Nearest;
+  d.storage = VdbMediumDesc::Storage::Dense;  // the walk reads every voxel's optics
+  d.max_dense_bytes = static_cast<uint64_t>(kMaxCells) * 3 * sizeof(float);
+  const VolumeData data = load_volume(d, source, P);
+  // The walk's voxels are cubes along the world axes.
+  const double* M = data.grid_to_world;
+  const double h = M[0];
+  const bool diagonal = M[1] == 0 && M[2] == 0 && M[4] == 0 && M[6] == 0 && M[8] == 0 && M[9] == 0;
+  if (!diagonal || !(h > 0) || std::abs(M[5] - h) > 1e-9 * h || std::abs(M[10] - h) > 1e-9 * h)
+    rd.fail(P + "/file", d.file + ": voxels of " + fmt(data.voxel_size[0]) + " x " +
+                             fmt(data.voxel_size[1]) + " x " + fmt(data.voxel_size[2]) +
+                             " mm" + (diagonal ? "" : ", rotated or sheared,") +
+                             " in the file's transform; a tissue needs cubic voxels along the "
+                             "world axes");
+  LabelVolume& v = s.volume;
+  v.n[0] = data.density.nx, v.n[1] = data.density.ny, v.n[2] = data.density.nz;
+  if (static_cast<double>(v.n[0]) * v.n[1] * v.n[2] > kMaxCells)
+    rd.fail(P + "/file", d.file + ": more than 2^28 voxels");
+  v.voxel = h;
+  v.origin = Vec3(M[3], M[7], M[11]);
+  v.labels.assign(v.cells(), 1);
+  v.voxel_optics.resize(v.cells());
+  double mu_a_sum = 0, mu_s_sum = 0;
+  for (int i = 0; i < v.n[0]; ++i)
+    for (int jj = 0; jj < v.n[1]; ++jj)
+      for (int k = 0; k < v.n[2]; ++k) {
+        const size_t src = data.density.index(i, jj, k);  // x fastest; the labels: z fastest
+        const double mu_t = d.sigma_t_scale * data.density.v[src];
+        const double a = data.albedo.empty() ? d.albedo : data.albedo.v[src];
+        const double n = data.eta.empty() ? d.eta : data.eta.v[src];
+        VoxelOptics& o = v.voxel_optics[v.index(i, jj, k)];
+        o.mu_s = static_cast<float>(a * mu_t);
+        o.mu_a = static_cast<float>(mu_t - a * mu_t);
+        o.n = static_cast<float>(n);
+        mu_a_sum += o.mu_a, mu_s_sum += o.mu_s;
+      }
+  // Label 1 names the whole medium; its table entry carries g and the mean coefficients.
+  const double cells = static_cast<double>(v.cells());
+  v.optics = {TissueOptics{0, 0, 0, outside_n},
+              TissueOptics{mu_a_sum / cells, mu_s_sum / cells, g, d.eta}};
+}
+
 void read_source(const Reader& rd, const Json& j, const std::string& P, Source& src) {
   rd.object(j, P,
             {"type", "position", "direction", "waist", "radius", "cone_angle", "falloff_start",
@@ -331,16 +399,25 @@ Setup load_tissue_scene(const std::string& text, const std::string& source,
   const std::string P = "/tissue";
   const Json& t = rd.object(
       root["tissue"], P,
-      {"volume", "labels", "outside_n", "boundary", "absorption", "source", "time", "fluence",
+      {"volume", "labels", "medium", "outside_n", "boundary", "absorption", "source", "time", "fluence",
        "faces", "detectors", "detected_photons", "photons", "seed", "batches"});
-  for (const char* k : {"volume", "labels", "source", "time"})
+  for (const char* k : {"source", "time"})
     if (!t.contains(k)) rd.fail(P + "/" + k, "required");
-  Setup s;
-  read_volume(rd, t["volume"], P + "/volume", s);
   const double outside_n =
       t.contains("outside_n") ? rd.number(t["outside_n"], P + "/outside_n", 1, 10) : 1.0;
-  s.volume.optics.assign(1, TissueOptics{});
-  read_labels(rd, t["labels"], P + "/labels", outside_n, s);
+  Setup s;
+  if (t.contains("medium")) {  // a voxel medium instead of a labelled volume
+    for (const char* k : {"volume", "labels"})
+      if (t.contains(k))
+        rd.fail(P + "/" + k, "a tissue is either \"medium\" or \"volume\" with \"labels\"");
+    read_medium(rd, t["medium"], P + "/medium", outside_n, source, s);
+  } else {
+    for (const char* k : {"volume", "labels"})
+      if (!t.contains(k)) rd.fail(P + "/" + k, "required (or a voxel \"medium\")");
+    read_volume(rd, t["volume"], P + "/volume", s);
+    s.volume.optics.assign(1, TissueOptics{});
+    read_labels(rd, t["labels"], P + "/labels", outside_n, s);
+  }
   if (t.contains("boundary"))
     s.fresnel = rd.string(t["boundary"], P + "/boundary", {"fresnel", "matched"}) == "fresnel";
   if (t.contains("absorption"))

@@ -9,12 +9,14 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "core/distributed/bytes.h"
 #include "core/distributed/comm.h"
 #include "core/lights.h"
 #include "core/progress.h"
 #include "core/sampling.h"
+#include "core/transport/voxel_space.h"
 #include "media/grid_medium.h"
 
 namespace femto::tissue {
@@ -402,11 +404,12 @@ struct Emitter {
   }
 };
 
-bool launch(const Setup& s, const LabelSpace& space, const Emitter& emitter, Rng& rng, Photon& p,
+template <class Space>
+bool launch(const Setup& s, const Space& space, const Emitter& emitter, Rng& rng, Photon& p,
             double& specular);
 
-template <class Tally>
-void trace_photon(const Setup& s, const LabelSpace& space, const Emitter& emitter,
+template <class Space, class Tally>
+void trace_photon(const Setup& s, const Space& space, const Emitter& emitter,
                   const WalkSettings& ws, Rng rng, Tally& tally, ChunkSums& out) {
   Photon p;
   double specular = 0;
@@ -441,7 +444,8 @@ namespace {
 // Launches photon p from the source (position, direction, time, weight) and moves it to the first
 // tissue voxel; false when it never reaches tissue. `specular` receives the weight reflected at
 // the entry surface (source.specular), already removed from p.w.
-bool launch(const Setup& s, const LabelSpace& space, const Emitter& emitter, Rng& rng, Photon& p,
+template <class Space>
+bool launch(const Setup& s, const Space& space, const Emitter& emitter, Rng& rng, Photon& p,
             double& specular) {
   const Source& src = s.source;
   const LabelVolume& vol = space.volume();
@@ -507,7 +511,7 @@ bool launch(const Setup& s, const LabelSpace& space, const Emitter& emitter, Rng
     p.x[axis] = vol.origin[axis] + (p.cell[axis] + (p.d[axis] > 0 ? 0 : 1)) * vol.voxel;
   }
   p.label = vol.label_at(p.cell[0], p.cell[1], p.cell[2]);
-  const double n1 = space.optics(0).n, n2 = space.optics(p.label).n;
+  const double n1 = space.outside_n(), n2 = space.optics_at(p).n;
   p.t += travelled * n1 / kSpeedOfLight;
   if (axis >= 0 && s.fresnel && n1 != n2) {
     const Fresnel fr = fresnel_dielectric(std::abs(p.d[axis]), n2 / n1);
@@ -556,6 +560,8 @@ uint64_t memory_bytes(const Setup& s, int threads) {
 Result simulate(const Setup& s) {
   const auto start = std::chrono::steady_clock::now();
   const LabelSpace space(s.volume, s.fresnel);
+  std::optional<VoxelSpace> voxel_space;  // a voxel medium: each voxel its own optics
+  if (!s.volume.voxel_optics.empty()) voxel_space.emplace(s.volume, s.fresnel);
   const Emitter emitter(s.source);
   const WalkSettings ws{s.absorption, s.time.t_end_ps()};
   const int threads = threads_for(s);
@@ -623,8 +629,13 @@ Result simulate(const Setup& s) {
         out.reset(labels, tpsf_size, ndet);
         Tally tally(s, ts, scale);
         const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
-        for (uint64_t i = q0; i < q1; ++i)
-          trace_photon(s, space, emitter, ws, Rng::for_sample(s.seed, i, 0), tally, out);
+        for (uint64_t i = q0; i < q1; ++i) {
+          const Rng rng = Rng::for_sample(s.seed, i, 0);
+          if (voxel_space)
+            trace_photon(s, *voxel_space, emitter, ws, rng, tally, out);
+          else
+            trace_photon(s, space, emitter, ws, rng, tally, out);
+        }
         progress.add(q1 - q0);
       });
     });

@@ -84,6 +84,7 @@ class UnboundedSpace {
  public:
   explicit UnboundedSpace(const TissueOptics& o) : o_(WalkOptics::of(o)) {}
   const WalkOptics& optics(int) const { return o_; }
+  const WalkOptics& optics_at(const Photon&) const { return o_; }
   double distance_to_interface(const Photon& p, double, int&, int end_cell[3]) const {
     for (int a = 0; a < 3; ++a) end_cell[a] = p.cell[a];
     return std::numeric_limits<double>::infinity();
@@ -93,6 +94,93 @@ class UnboundedSpace {
  private:
   WalkOptics o_;
 };
+
+/// The march shared by the voxel spaces: the distance along p.d from p (in voxel p.cell of
+/// `vol`) to the first face whose neighbour is outside the grid or fails same(index of the
+/// neighbour in vol.labels), if it comes before s_stop (else +inf); see
+/// LabelSpace::distance_to_interface.
+template <class Same>
+double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, int& axis,
+                       int end_cell[3], Same same) {
+  const VoxelDda dda(p.x, p.d, p.cell, vol.origin, Vec3(vol.voxel));
+  // Scalars rather than arrays indexed by the moving axis keep the march in registers; the
+  // voxel's index moves by a fixed stride per axis.
+  int cx = dda.cell[0], cy = dda.cell[1], cz = dda.cell[2];
+  double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
+  const ptrdiff_t sx = dda.step[0] * static_cast<ptrdiff_t>(vol.n[1]) * vol.n[2];
+  const ptrdiff_t sy = dda.step[1] * static_cast<ptrdiff_t>(vol.n[2]), sz = dda.step[2];
+  ptrdiff_t i = static_cast<ptrdiff_t>(vol.index(cx, cy, cz));  // a tissue voxel: in the grid
+  double s = std::numeric_limits<double>::infinity();
+  while (true) {
+    if (tx < ty && tx < tz) {  // the same choice as VoxelDda::axis()
+      if (tx >= s_stop) break;
+      const int c = cx + dda.step[0];
+      if (c < 0 || c >= vol.n[0] || !same(i + sx)) {
+        s = tx, axis = 0;
+        break;
+      }
+      cx = c, i += sx, tx += dda.t_delta[0];
+    } else if (!(tx < ty) && ty < tz) {
+      if (ty >= s_stop) break;
+      const int c = cy + dda.step[1];
+      if (c < 0 || c >= vol.n[1] || !same(i + sy)) {
+        s = ty, axis = 1;
+        break;
+      }
+      cy = c, i += sy, ty += dda.t_delta[1];
+    } else {
+      if (tz >= s_stop) break;
+      const int c = cz + dda.step[2];
+      if (c < 0 || c >= vol.n[2] || !same(i + sz)) {
+        s = tz, axis = 2;
+        break;
+      }
+      cz = c, i += sz, tz += dda.t_delta[2];
+    }
+  }
+  end_cell[0] = cx, end_cell[1] = cy, end_cell[2] = cz;
+  return s;
+}
+
+/// Puts p exactly on the face of its voxel on `axis` that it moves towards (no drift) and gives
+/// the voxel beyond that face.
+inline void face_neighbour(const LabelVolume& vol, Photon& p, int axis, int next[3]) {
+  const int step = p.d[axis] > 0 ? 1 : -1;
+  p.x[axis] = vol.origin[axis] + (p.cell[axis] + (step > 0 ? 1 : 0)) * vol.voxel;
+  p.face_axis = axis;
+  next[0] = p.cell[0], next[1] = p.cell[1], next[2] = p.cell[2];
+  next[axis] += step;
+}
+
+/// At a face on `axis` between indices n1 (the photon's side) and n2: true if the photon is
+/// reflected (Fresnel reflectance of unpolarised light, total internal reflection included),
+/// else its direction is refracted by Snell's law (unchanged when n1 == n2).
+inline bool reflect_or_refract(Photon& p, int axis, double n1, double n2, Rng& rng) {
+  if (n1 == n2) return false;
+  const double cos_i = std::abs(p.d[axis]);
+  const Fresnel fr = fresnel_dielectric(cos_i, n2 / n1);
+  if (fr.R >= 1.0 || rng.uniform() < fr.R) {
+    p.d[axis] = -p.d[axis];
+    return true;
+  }
+  // Snell: tangential components scale by n1 / n2, the normal one becomes cos_t.
+  const double step = p.d[axis] > 0 ? 1.0 : -1.0;
+  Vec3 d = p.d * (n1 / n2);
+  d[axis] = step * fr.cos_t;
+  p.d = normalize(d);
+  return false;
+}
+
+/// Moves p into voxel `next` of label `label`; label 0 is outside (the photon has left).
+inline StepEvent enter(Photon& p, const int next[3], int label) {
+  p.cell[0] = next[0], p.cell[1] = next[1], p.cell[2] = next[2];
+  p.label = label;
+  if (label == 0) {
+    p.alive = false;
+    return StepEvent::Escaped;
+  }
+  return StepEvent::Face;
+}
 
 /// A labelled voxel grid. Where the label changes across a voxel face (another tissue, or label
 /// 0 at the outer surface) and the refractive index differs, the photon is reflected with the
@@ -105,85 +193,31 @@ class LabelSpace {
   }
   const LabelVolume& volume() const { return vol_; }
   const WalkOptics& optics(int label) const { return optics_[static_cast<size_t>(label)]; }
+  /// The optics where photon p is (its label's).
+  const WalkOptics& optics_at(const Photon& p) const { return optics(p.label); }
+  double outside_n() const { return optics_[0].n; }
 
   /// Distance along p.d to the first voxel face where the label changes, if it comes before
   /// s_stop (else +inf); `axis` is that face's axis. end_cell: the voxel holding the end of the
   /// piece (the last voxel before that face, or the voxel at s_stop). Faces between voxels of
   /// the same label are crossed here, without a step of the walk.
   double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3]) const {
-    const VoxelDda dda(p.x, p.d, p.cell, vol_.origin, Vec3(vol_.voxel));
-    // Scalars rather than arrays indexed by the moving axis keep the march in registers; the
-    // voxel's index into the labels moves by a fixed stride per axis.
-    int cx = dda.cell[0], cy = dda.cell[1], cz = dda.cell[2];
-    double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
-    const ptrdiff_t sx = dda.step[0] * static_cast<ptrdiff_t>(vol_.n[1]) * vol_.n[2];
-    const ptrdiff_t sy = dda.step[1] * static_cast<ptrdiff_t>(vol_.n[2]), sz = dda.step[2];
     const uint16_t* labels = vol_.labels.data();
-    ptrdiff_t i = static_cast<ptrdiff_t>(vol_.index(cx, cy, cz));  // a tissue voxel: in the grid
-    const int label = p.label;
-    double s = std::numeric_limits<double>::infinity();
-    while (true) {
-      if (tx < ty && tx < tz) {  // the same choice as VoxelDda::axis()
-        if (tx >= s_stop) break;
-        const int c = cx + dda.step[0];
-        if (c < 0 || c >= vol_.n[0] || labels[i + sx] != label) {
-          s = tx, axis = 0;
-          break;
-        }
-        cx = c, i += sx, tx += dda.t_delta[0];
-      } else if (!(tx < ty) && ty < tz) {
-        if (ty >= s_stop) break;
-        const int c = cy + dda.step[1];
-        if (c < 0 || c >= vol_.n[1] || labels[i + sy] != label) {
-          s = ty, axis = 1;
-          break;
-        }
-        cy = c, i += sy, ty += dda.t_delta[1];
-      } else {
-        if (tz >= s_stop) break;
-        const int c = cz + dda.step[2];
-        if (c < 0 || c >= vol_.n[2] || labels[i + sz] != label) {
-          s = tz, axis = 2;
-          break;
-        }
-        cz = c, i += sz, tz += dda.t_delta[2];
-      }
-    }
-    end_cell[0] = cx, end_cell[1] = cy, end_cell[2] = cz;
-    return s;
+    const uint16_t label = static_cast<uint16_t>(p.label);
+    return march_to_change(vol_, p, s_stop, axis, end_cell,
+                           [&](ptrdiff_t i) { return labels[i] == label; });
   }
 
   /// The photon is on the face of its voxel on `axis`, facing another label: reflect, or move
   /// into the neighbour.
   StepEvent cross(Photon& p, int axis, Rng& rng) const {
-    const int step = p.d[axis] > 0 ? 1 : -1;
-    p.x[axis] = vol_.origin[axis] + (p.cell[axis] + (step > 0 ? 1 : 0)) * vol_.voxel;  // no drift
-    p.face_axis = axis;
-    int next[3] = {p.cell[0], p.cell[1], p.cell[2]};
-    next[axis] += step;
+    int next[3];
+    face_neighbour(vol_, p, axis, next);
     const int label = vol_.label_at(next[0], next[1], next[2]);
-    const double n1 = optics_[static_cast<size_t>(p.label)].n,
-                 n2 = optics_[static_cast<size_t>(label)].n;
-    if (fresnel_ && n1 != n2) {
-      const double cos_i = std::abs(p.d[axis]);
-      const Fresnel fr = fresnel_dielectric(cos_i, n2 / n1);
-      if (fr.R >= 1.0 || rng.uniform() < fr.R) {
-        p.d[axis] = -p.d[axis];
-        return StepEvent::Reflected;
-      }
-      // Snell: tangential components scale by n1 / n2, the normal one becomes cos_t.
-      const double r = n1 / n2;
-      Vec3 d = p.d * r;
-      d[axis] = step * fr.cos_t;
-      p.d = normalize(d);
-    }
-    p.cell[0] = next[0], p.cell[1] = next[1], p.cell[2] = next[2];
-    p.label = label;
-    if (label == 0) {
-      p.alive = false;
-      return StepEvent::Escaped;
-    }
-    return StepEvent::Face;
+    if (fresnel_ && reflect_or_refract(p, axis, optics_[static_cast<size_t>(p.label)].n,
+                                       optics_[static_cast<size_t>(label)].n, rng))
+      return StepEvent::Reflected;
+    return enter(p, next, label);
   }
 
  private:
@@ -204,7 +238,7 @@ inline double one_minus_exp(double x) {
 template <class Space>
 StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& rng, Segment& seg) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  const WalkOptics& o = space.optics(p.label);
+  const auto& o = space.optics_at(p);  // a reference, or a voxel's optics by value
   const bool analog = ws.absorption == Absorption::Analog;
   const double rate = analog ? o.mu_t : o.mu_s;
   if (p.tau_left < 0) p.tau_left = -std::log(1 - rng.uniform());  // 1 - u is exact
