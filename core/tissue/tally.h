@@ -1,0 +1,285 @@
+#pragma once
+// The tallies of the tissue photon walk (docs/tissue.md, "Design"): a Tally sees the segments and
+// escapes of one photon at a time and adds them to the fixed-point volume sums of its thread
+// (fluence, face images) and to the sums of the photon's chunk (energy balance, detectors).
+// Inline: its calls sit in the walk's loop.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "core/tissue/chunk_sums.h"
+#include "core/tissue/setup.h"
+#include "core/transport/photon.h"
+#include "media/grid_medium.h"  // clamped_floor
+
+namespace femto::tissue {
+
+/// Fluence cells in 4 x 4 x 4 bricks (512 bytes of sums each): a photon's neighbouring voxels
+// share cache lines, where a row-major layout puts x neighbours a whole plane apart.
+struct BrickLayout {
+  int nb[3] = {0, 0, 0};
+  size_t slots = 0;  ///< bricks x 64, padded cells included
+  explicit BrickLayout(const int n[3]) {
+    for (int a = 0; a < 3; ++a) nb[a] = (n[a] + 3) / 4;
+    slots = static_cast<size_t>(nb[0]) * nb[1] * nb[2] * 64;
+  }
+  size_t index(int i, int j, int k) const {
+    const size_t brick = (static_cast<size_t>(i >> 2) * nb[1] + (j >> 2)) * nb[2] + (k >> 2);
+    return brick * 64 + static_cast<size_t>(((i & 3) << 4) | ((j & 3) << 2) | (k & 3));
+  }
+};
+
+/// Integer sums of the volume tallies of one thread (fixed point: order-independent).
+struct ThreadSums {
+  std::vector<uint64_t> fluence;
+  std::array<std::vector<uint64_t>, 6> faces;
+};
+
+/// The tallies of one photon walk, plugged into walk_step's loop.
+class Tally {
+ public:
+  Tally(const Setup& s, ThreadSums& sums, double scale)
+      : layout_(s.fluence_grid.n),
+        s_(s),
+        sums_(sums),
+        scale_(scale),
+        gates_(s.time.bins),
+        same_grid_(s.fluence && same_grid(s)),
+        ppath_(s.volume.optics.size(), 0.0) {
+    const FluenceGrid& fg = s.fluence_grid;
+    h_ = fg.spacing();
+    cells_ = layout_.slots;
+    plane_tolerance_ = 1e-6 * s.volume.voxel;
+  }
+  void begin(ChunkSums& out) {
+    out_ = &out;
+    std::fill(ppath_.begin(), ppath_.end(), 0.0);
+  }
+
+  void segment(const Segment& seg) {
+    ++out_->segments;
+    out_->absorbed[static_cast<size_t>(seg.label)] += seg.absorbed;
+    out_->balance.absorbed += seg.absorbed;
+    if (!s_.detectors.empty()) ppath_[static_cast<size_t>(seg.label)] += seg.length();
+    if (s_.fluence && seg.duration > 0) fluence(seg);
+  }
+
+  void escape(const Photon& p) {
+    const LabelVolume& vol = s_.volume;
+    int face = -1;
+    for (int a = 0; a < 3; ++a) {
+      if (p.cell[a] < 0) face = 2 * a;
+      if (p.cell[a] >= vol.n[a]) face = 2 * a + 1;
+    }
+    if (face < 0) {
+      out_->balance.escaped_inside += p.w;
+    } else {
+      out_->balance.escaped_faces[static_cast<size_t>(face)] += p.w;
+      if (s_.faces) face_image(face, p);
+    }
+    if (!s_.detectors.empty()) detect(p);
+  }
+
+  void alive(const Photon& p) { out_->balance.alive += p.w; }
+  void end() { flush(); }
+
+ private:
+  static bool same_grid(const Setup& s) {
+    const FluenceGrid& fg = s.fluence_grid;
+    const LabelVolume& v = s.volume;
+    for (int a = 0; a < 3; ++a)
+      if (fg.n[a] != v.n[a] || fg.origin[a] != v.origin[a] || fg.size[a] != v.n[a] * v.voxel)
+        return false;
+    return true;
+  }
+
+  // Through int64 (values stay below 2^63 by the choice of scale): one instruction, where a
+  // direct double -> uint64 conversion needs a branch for the upper half.
+  uint64_t fixed(double x) const {
+    return static_cast<uint64_t>(static_cast<int64_t>(x * scale_ + 0.5));
+  }
+
+  // Consecutive deposits into the same entry (scatterings inside one voxel) are summed first:
+  // fewer memory round trips and fewer roundings.
+  void add(size_t i, double x) {
+    if (i != pending_) {
+      flush();
+      pending_ = i;
+    }
+    pending_value_ += x;
+  }
+  void flush() {
+    if (pending_ != kNone) sums_.fluence[pending_] += fixed(pending_value_);
+    pending_ = kNone;
+    pending_value_ = 0;
+  }
+
+  // Adds the weighted track length of seg over tau in [a, b] (ps since its start) to cell `c`,
+  // split at the gate boundaries.
+  void deposit(const Segment& seg, size_t c, double a, double b) {
+    const TimeAxis& ax = s_.time;
+    const double lo = std::max(seg.t0 + a, ax.t_start_ps), hi = std::min(seg.t0 + b, ax.t_end_ps());
+    if (!(hi > lo)) return;
+    int j = std::clamp(static_cast<int>((lo - ax.t_start_ps) / ax.bin_width_ps), 0, gates_ - 1);
+    // Gate-major: a photon's consecutive deposits fall in one gate's grid, which stays in cache.
+    const size_t stride = cells_;
+    for (double t = lo; t < hi && j < gates_; ++j) {
+      const double te = j == gates_ - 1 ? hi : std::min(hi, ax.bin_start_ps(j + 1));
+      if (te > t)
+        add(c + j * stride, seg.w0 * seg.v * exp_integral(seg.k, t - seg.t0, te - seg.t0));
+      t = std::max(t, te);
+    }
+  }
+
+  // Integral of exp(-mu s) over a piece of length ds, divided by ds: (1 - e^-x) / x with
+  // x = mu ds, and e^-x itself (a series for small x: no exponential per voxel).
+  static double mean_decay(double x, double& e) {
+    if (x < 0.01) {  // truncation below x^5 / 720 < 1.4e-13
+      const double g = 1 - x * (0.5 - x * (1.0 / 6 - x * (1.0 / 24 - x * (1.0 / 120))));
+      e = 1 - x * g;
+      return g;
+    }
+    e = std::exp(-x);
+    return (1 - e) / x;
+  }
+
+  void fluence(const Segment& seg) {
+    if (same_grid_) {
+      // The label grid's voxels along the segment; the weight factor exp(-mu_a s) is carried
+      // from voxel to voxel.
+      const LabelVolume& vol = s_.volume;
+      const TimeAxis& ax = s_.time;
+      const double L = seg.distance, mu = seg.k / seg.v, inv_v = 1.0 / seg.v;
+      const int j0 = ax.bin_of(seg.t0);
+      const bool one_gate = j0 >= 0 && seg.t0 + seg.duration <= ax.bin_start_ps(j0 + 1);
+      const size_t gate_offset = one_gate ? static_cast<size_t>(j0) * cells_ : 0;
+      const VoxelDda dda(seg.x0, seg.d, seg.cell, vol.origin, Vec3(vol.voxel));
+      // One label: every voxel is in the grid.
+      double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
+      int cx = seg.cell[0], cy = seg.cell[1], cz = seg.cell[2];
+      double sa = 0, ea = 1;
+      while (true) {
+        const int a = tx < ty && tx < tz ? 0 : (!(tx < ty) && ty < tz ? 1 : 2);  // VoxelDda::axis()
+        const double t = a == 0 ? tx : (a == 1 ? ty : tz);
+        const bool last = t >= L;
+        const double sb = last ? L : t;
+        if (sb > sa) {
+          const size_t c = layout_.index(cx, cy, cz);
+          if (one_gate) {
+            double e;
+            const double g = mean_decay(mu * (sb - sa), e);
+            add(c + gate_offset, seg.w0 * ea * (sb - sa) * g);
+            ea *= e;
+          } else {  // the segment crosses gates (or the window start): split exactly
+            deposit(seg, c, sa * inv_v, sb * inv_v);
+            ea = mu > 0 ? std::exp(-mu * sb) : 1.0;
+          }
+        }
+        if (last) break;
+        sa = sb;
+        if (a == 0)
+          cx += dda.step[0], tx += dda.t_delta[0];
+        else if (a == 1)
+          cy += dda.step[1], ty += dda.t_delta[1];
+        else
+          cz += dda.step[2], tz += dda.t_delta[2];
+      }
+      return;
+    }
+    // Walk the fluence grid's cells along the segment (3-D DDA), clipped to its box.
+    const FluenceGrid& fg = s_.fluence_grid;
+    const double L = seg.length();
+    double s0 = 0, s1 = L;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = fg.origin[a], hi = fg.origin[a] + fg.size[a], x = seg.x0[a], d = seg.d[a];
+      if (d == 0) {
+        if (x < lo || x >= hi) return;
+        continue;
+      }
+      const double ta = (lo - x) / d, tb = (hi - x) / d;
+      s0 = std::max(s0, std::min(ta, tb));
+      s1 = std::min(s1, std::max(ta, tb));
+    }
+    if (!(s1 > s0)) return;
+    int c[3], step[3];
+    double next[3], delta[3];
+    const double sm = 0.5 * (s0 + std::min(s1, s0 + 1e-9 * (1 + L)));  // a point just inside
+    for (int a = 0; a < 3; ++a) {
+      const double x = seg.x0[a] + seg.d[a] * sm, d = seg.d[a];
+      c[a] = std::clamp(clamped_floor((x - fg.origin[a]) / h_[a]), 0, fg.n[a] - 1);
+      step[a] = d > 0 ? 1 : -1;
+      const double face = fg.origin[a] + (c[a] + (d > 0 ? 1 : 0)) * h_[a];
+      next[a] = d != 0 ? (face - seg.x0[a]) / d : std::numeric_limits<double>::infinity();
+      delta[a] = d != 0 ? h_[a] / std::abs(d) : std::numeric_limits<double>::infinity();
+    }
+    double s = s0;
+    while (s < s1) {
+      const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+      const double e = std::min(next[a], s1);
+      if (e > s) {
+        deposit(seg, layout_.index(c[0], c[1], c[2]), s / seg.v, e / seg.v);
+      }
+      s = std::max(s, e);
+      c[a] += step[a];
+      next[a] += delta[a];
+      if (c[a] < 0 || c[a] >= fg.n[a]) break;
+    }
+  }
+
+  void face_image(int face, const Photon& p) {
+    const int gate = s_.time.bin_of(p.t);
+    if (gate < 0) return;
+    const int axis = face / 2, b = axis == 0 ? 1 : 0, c = axis == 2 ? 1 : 2;
+    const LabelVolume& vol = s_.volume;
+    const size_t pix = static_cast<size_t>(p.cell[b]) * vol.n[c] + p.cell[c];
+    sums_.faces[static_cast<size_t>(face)][pix * gates_ + gate] += fixed(p.w);
+  }
+
+  void detect(const Photon& p) {
+    const double n_out = s_.volume.optics[0].n;
+    for (size_t i = 0; i < s_.detectors.size(); ++i) {
+      const Detector& det = s_.detectors[i];
+      const Vec3 r = p.x - det.center;
+      if (dot(r, r) > det.radius * det.radius) continue;
+      // The disc lies in the plane of the face the photon leaves through.
+      if (p.face_axis >= 0 && std::abs(r[p.face_axis]) > plane_tolerance_) continue;
+      if (det.na > 0 && p.face_axis >= 0) {
+        const double cos_out = std::abs(p.d[p.face_axis]);  // exit angle from the face normal
+        const double sin_max = det.na / n_out;
+        if (sin_max < 1 && cos_out * cos_out < 1 - sin_max * sin_max) continue;
+      }
+      const int gate = s_.time.bin_of(p.t);
+      if (gate >= 0) out_->tpsf[i * static_cast<size_t>(gates_) + gate] += p.w;
+      out_->detected[i] += p.w;
+      DetectedPhotons& rec = out_->records;
+      if (!s_.save_detected) return;
+      rec.detector.push_back(static_cast<int32_t>(i));
+      rec.scatterings.push_back(p.scatterings);
+      rec.weight.push_back(p.w);
+      rec.time_ps.push_back(p.t);
+      rec.ppath.insert(rec.ppath.end(), ppath_.begin() + 1, ppath_.end());
+      rec.exit.insert(rec.exit.end(), {p.x.x, p.x.y, p.x.z, p.d.x, p.d.y, p.d.z});
+      return;  // a photon counts for the first detector it reaches
+    }
+  }
+
+  BrickLayout layout_;
+  const Setup& s_;
+  ThreadSums& sums_;
+  double scale_;
+  int gates_;
+  bool same_grid_;
+  Vec3 h_;
+  size_t cells_ = 0;
+  double plane_tolerance_ = 0;
+  static constexpr size_t kNone = ~size_t{0};
+  size_t pending_ = kNone;
+  double pending_value_ = 0;
+  std::vector<double> ppath_;  // per label, this photon
+  ChunkSums* out_ = nullptr;
+};
+
+}  // namespace femto::tissue
