@@ -1,6 +1,7 @@
 #pragma once
 // Everything a tissue-optics run needs (docs/tissue.md): the labelled volume, the boundary
 // model, the pulsed source, the time gates and the tallies.
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -73,6 +74,11 @@ struct Setup {
   /// The processes sharing the run (core/distributed/comm.h; nullptr: this one alone): chunk c of
   /// a batch is traced by rank c % ranks and rank 0 gets the result of a single process.
   const distributed::Comm* comm = nullptr;
+  /// Set by another thread: simulate() skips the chunks not yet started and throws
+  /// tissue::Stopped.
+  const std::atomic<bool>* stop = nullptr;
+  /// Photons traced so far, raised after every chunk (for a progress display elsewhere).
+  std::atomic<uint64_t>* photons_done = nullptr;
 };
 
 }  // namespace femto::tissue

@@ -171,6 +171,7 @@ Result simulate(const Setup& s) {
     arena.execute([&] {
       tbb::parallel_for(size_t{0}, chunks, [&](size_t c) {
         if (!comm.owns(static_cast<int64_t>(c))) return;
+        if (s.stop && s.stop->load()) return;  // the batch is thrown away: Stopped below
         ThreadSums& ts = thread_sums.local();
         ChunkSums& out = chunk[c];
         out.reset(labels, tpsf_size, ndet);
@@ -184,10 +185,12 @@ Result simulate(const Setup& s) {
             trace_photon(s, space, emitter, ws, rng, tally, out);
         }
         progress.add(q1 - q0);
+        if (s.photons_done) s.photons_done->fetch_add(q1 - q0);
       });
     });
     r.trace_seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - trace_start).count();
+    if (s.stop && s.stop->load()) throw Stopped();
     if (!comm.single()) {
       distributed::ByteWriter mine;
       if (!comm.root())

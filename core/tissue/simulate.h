@@ -7,6 +7,7 @@
 // point (integer sums do not depend on order); per-chunk sums are reduced in chunk order.
 #include <array>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 #include "core/tissue/setup.h"
@@ -70,6 +71,11 @@ uint64_t memory_bytes(const Setup& setup, int threads);
 uint64_t fluence_bytes_per_thread(const Setup& setup);
 /// Threads the run will use for setup.threads.
 int threads_for(const Setup& setup);
+
+/// Thrown by simulate() when Setup::stop is set (after the batch that was running).
+struct Stopped : std::runtime_error {
+  Stopped() : std::runtime_error("the tissue run was stopped") {}
+};
 
 Result simulate(const Setup& setup);
 

@@ -60,5 +60,6 @@ void register_render(py::module_& m);
 void register_scene(py::module_& m);
 void register_diffusion(py::module_& m);
 void register_uniformity(py::module_& m);
+void register_tissue(py::module_& m);
 
 }  // namespace femto::python

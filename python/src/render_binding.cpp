@@ -95,7 +95,7 @@ std::shared_ptr<RenderOutput> render_py(const py::object& scene, const py::objec
   if (tissue::is_tissue_scene(text.text))
     throw py::value_error(text.source +
                           ": a tissue scene (docs/tissue.md); femto.render takes camera scenes, "
-                          "run tissue scenes with the femto render command");
+                          "run tissue scenes with femto.tissue");
   SceneDesc desc;
   try {
     desc = load_scene_string(text.text, text.source, text.base_dir);
