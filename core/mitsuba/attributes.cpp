@@ -24,6 +24,12 @@ void Importer::check_text(Node n) const {
       fail(n, "unexpected text '" + clip(c.value(), 40) + "' inside the element");
 }
 
+// Plugins take the attributes type, id and name only.
+std::string Importer::plugin_type(Node n) const {
+  check_attributes(n, {"type", "id", "name"});
+  return attr(n, "type");
+}
+
 std::string Importer::raw_attr(Node n, const char* name) const {
   const pugi::xml_attribute a = n.attribute(name);
   if (!a) fail(n, std::string("missing attribute '") + name + "'");

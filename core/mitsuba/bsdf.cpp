@@ -65,8 +65,7 @@ Importer::Material Importer::bsdf(Node ref, int depth) const {
   const Node n = resolve(ref, depth);
   if (std::string(n.name()) != "bsdf")
     fail(ref, "expected a <bsdf> (the id names a <" + clip(n.name()) + ">)");
-  check_attributes(n, {"type", "id", "name"});
-  const std::string type = attr(n, "type");
+  const std::string type = plugin_type(n);
   Props p = props(n);
   Material m;
   if (type == "twosided") {

@@ -5,8 +5,7 @@
 namespace femto::mitsuba {
 
 void Importer::light(Node n) {
-  check_attributes(n, {"type", "id", "name"});
-  const std::string type = attr(n, "type");
+  const std::string type = plugin_type(n);
   const std::string path = "/lights/" + std::to_string(out_["lights"].size());
   origin(path, n);
   if (type == "area") fail(n, "an area emitter belongs inside a <shape>");

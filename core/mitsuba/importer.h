@@ -85,6 +85,7 @@ class Importer {
   // attributes.cpp: attributes, $variables and the numbers in them.
   void check_attributes(Node n, std::initializer_list<const char*> allowed) const;
   void check_text(Node n) const;
+  std::string plugin_type(Node n) const;
   std::string raw_attr(Node n, const char* name) const;
   std::string required_attr(Node n, const char* name) const;
   std::string attr(Node n, const char* name) const;

@@ -10,8 +10,7 @@ void Importer::medium_check(Node n) const {
 }
 
 Json Importer::medium_json(Node n) const {
-  check_attributes(n, {"type", "id", "name"});
-  const std::string type = attr(n, "type");
+  const std::string type = plugin_type(n);
   if (type != "homogeneous")
     fail(n, "unsupported medium \"" + clip(type) +
                 "\" (femto reads \"homogeneous\"; voxel media: "
@@ -44,8 +43,7 @@ Json Importer::medium_json(Node n) const {
   for (Node c : p.objects) {
     if (std::string(c.name()) != "phase")
       fail(c, "unsupported element inside <medium> (a <phase> is)");
-    check_attributes(c, {"type", "id", "name"});
-    const std::string pt = attr(c, "type");
+    const std::string pt = plugin_type(c);
     Props pp = props(c);
     if (pt == "hg") {
       g = get_float(pp, "g", 0.8);  // Mitsuba's default

@@ -8,8 +8,7 @@
 namespace femto::mitsuba {
 
 void Importer::sensor(Node n) {
-  check_attributes(n, {"type", "id", "name"});
-  const std::string type = attr(n, "type");
+  const std::string type = plugin_type(n);
   if (type != "perspective")
     fail(n, "unsupported sensor type \"" + clip(type) + "\" (femto supports \"perspective\")");
   Props p = props(n);
@@ -103,8 +102,7 @@ void Importer::sensor(Node n) {
 }
 
 std::pair<long long, long long> Importer::film(Node n) {
-  check_attributes(n, {"type", "id", "name"});
-  const std::string type = attr(n, "type");
+  const std::string type = plugin_type(n);
   if (type != "transient_hdr_film")
     fail(n, "unsupported film \"" + clip(type) +
                 "\": femto renders a time axis; use mitransient's \"transient_hdr_film\" with "
@@ -135,8 +133,7 @@ std::pair<long long, long long> Importer::film(Node n) {
   for (Node c : p.objects) {
     if (std::string(c.name()) != "rfilter")
       fail(c, "unsupported element inside <film> (an <rfilter> is)");
-    check_attributes(c, {"type", "id", "name"});
-    if (attr(c, "type") != "box")
+    if (plugin_type(c) != "box")
       warn(c, "not used: femto's pixel filter is a box (uniform over the pixel)");
     else
       check_all_used(props(c));
@@ -186,8 +183,7 @@ void Importer::integrator(Node n) {
   Json render = out_.contains("render") ? out_["render"] : Json::object();
   render["integrator"] = "path";  // mitransient's integrators trace camera paths only
   if (n) {
-    check_attributes(n, {"type", "id", "name"});
-    const std::string type = attr(n, "type");
+    const std::string type = plugin_type(n);
     static const std::set<std::string> kTransient = {"transient_path", "transientpath",
                                                      "transient_prbvolpath"};
     if (!kTransient.count(type))

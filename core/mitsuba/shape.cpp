@@ -9,8 +9,7 @@
 namespace femto::mitsuba {
 
 void Importer::shape(Node n) {
-  check_attributes(n, {"type", "id", "name"});
-  const std::string type = attr(n, "type");
+  const std::string type = plugin_type(n);
   const std::string path = "/shapes/" + std::to_string(out_["shapes"].size());
   origin(path, n);
   Props p = props(n);
@@ -141,8 +140,7 @@ void Importer::shape(Node n) {
   }
   if (emitter_node) {
     const Node e = resolve(emitter_node, 0);
-    check_attributes(e, {"type", "id", "name"});
-    if (attr(e, "type") != "area") fail(e, "a shape's emitter must be of type \"area\"");
+    if (plugin_type(e) != "area") fail(e, "a shape's emitter must be of type \"area\"");
     Props ep = props(e);
     const RGB L = get_rgb(ep, "radiance", RGB(1.0));
     check_all_used(ep);
