@@ -1,7 +1,7 @@
 // libFuzzer target: loading a .vdb volume from arbitrary bytes, as `femto info` and `femto
 // render` do: the bytes are written to a temporary file, then load_volume runs femto's
 // structure check (media/vdb_structure.cpp), OpenVDB's reader and femto's own checks
-// (media/volume_data.cpp); a volume that loads is then built into a GridMedium as the renderer
+// (media/volume_checks.cpp); a volume that loads is then built into a GridMedium as the renderer
 // does. A file that loads with its density grid is loaded again with the albedo and eta grids
 // of the tissue example. Bad input must be an InputError; any other exception, a crash, a hang,
 // an allocation above libFuzzer's -malloc_limit_mb or a sanitizer report is a finding.

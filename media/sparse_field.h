@@ -3,7 +3,7 @@
 // bricks, found through a two-level table (nodes of 128^3 voxels, then leaves of 8^3); regions
 // without a leaf (empty space, tiles) are constants. Per node and per leaf block of field cells
 // the walker has bounds (largest and smallest sigma_t, constant eta) to cross them in one step.
-// Plain data: OpenVDB stays inside volume_data.cpp, which builds it.
+// Plain data: OpenVDB stays inside the volume loader (media/volume_loader.h), which builds it.
 #include <cstddef>
 #include <cstdint>
 #include <memory>

@@ -6,13 +6,7 @@
 #include <memory>
 #include <vector>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#include <openvdb/openvdb.h>
-#pragma GCC diagnostic pop
-
+#include "media/openvdb_headers.h"
 #include "media/sparse_field.h"
 
 namespace femto {

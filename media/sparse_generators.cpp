@@ -8,17 +8,10 @@
 #include <mutex>
 #include <vector>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
-#pragma GCC diagnostic pop
-
 #include "core/error.h"
 #include "core/io/atomic_file.h"
 #include "core/rng.h"
+#include "media/openvdb_headers.h"
 
 namespace femto {
 namespace {

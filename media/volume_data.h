@@ -1,6 +1,6 @@
 #pragma once
 // Heterogeneous volumes read from OpenVDB files into dense in-memory grids (docs/volumes.md).
-// OpenVDB itself stays inside volume_data.cpp; this header is plain data.
+// OpenVDB stays inside the loader and writer (media/volume_loader.h); this header is plain data.
 #include <array>
 #include <cstddef>
 #include <cstdint>
