@@ -1,7 +1,5 @@
 #include "core/integrators/volpath.h"
 
-#include "core/integrators/connection_choice.h"
-
 #include <cmath>
 #include <limits>
 
@@ -51,7 +49,32 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
 
 bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
   if (!active) return false;
-  return all || auto_connects(light, ray.o, ray.d, s_surf, sigma_t);
+  return all || decided || auto_connects(light, ray.o, ray.d, s_surf, sigma_t);
+}
+
+VolPathIntegrator::ConnectedSegment VolPathIntegrator::plan_segment(const Medium& med,
+                                                                    const Ray& ray,
+                                                                    double s_surf) const {
+  ConnectedSegment segment;
+  if (med.connection == ConnectionSampling::Collision || point_lights_.empty() ||
+      !med.interacts())
+    return segment;
+  segment.ray = ray;
+  segment.s_surf = s_surf;
+  segment.all = med.connection != ConnectionSampling::Auto;
+  if (segment.all) {
+    segment.active = true;
+    return segment;
+  }
+  segment.sigma_t = spread_sigma_t(med, ray.o);
+  const LightSet& lights = scene_.lights();
+  for (int li : point_lights_)
+    if (auto_connects(lights.light(li), ray.o, ray.d, s_surf, segment.sigma_t)) {
+      segment.active = true;
+      break;
+    }
+  segment.decided = point_lights_.size() == 1;
+  return segment;
 }
 
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
@@ -167,18 +190,9 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     } else {
       const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next);
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
-      const bool segment_connections =
-          med.connection != ConnectionSampling::Collision && !point_lights_.empty();
-      ConnectedSegment segment;
-      segment.active = segment_connections;
-      segment.all = med.connection != ConnectionSampling::Auto;
-      segment.ray = ray;
-      segment.s_surf = s_surf;
-      segment.sigma_t = segment_connections && !segment.all
-                            ? spread_sigma_t(med, ray.o)
-                            : 0.0;
-      if (segment_connections && depth < max_depth_)
-        estimate_segment(med, m, ray, s_surf, beta, t, t_dropped, rng, acc, stats);
+      const ConnectedSegment segment = plan_segment(med, ray, s_surf);
+      if (segment.active && depth < max_depth_)
+        estimate_segment(med, m, segment, beta, t, t_dropped, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every
       // strategy's MIS weight at this segment's vertices sees the same r_aux.
       const bool angular = med.direction == DirectionSampling::Angular && !point_lights_.empty() &&
