@@ -200,7 +200,7 @@ nlohmann::json render_info(const Scene& scene, const std::string& scene_text, co
                       {"russian_roulette", false}};
   nlohmann::json media = nlohmann::json::array();
   {
-    const char* names[] = {"mfp", "time_uniform", "mis"};
+    const char* names[] = {"mfp", "time_uniform", "mis", "mixture"};
     for (size_t i = 0; i < scene.desc().media.size(); ++i) {
       const MediumDesc& md = scene.desc().media[i];
       const Medium& rm = scene.media()[i];

@@ -122,6 +122,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
       {"mis + collision", DistanceSampling::Mis, ConnectionSampling::Collision, false},
       {"time_uniform + collision", DistanceSampling::TimeUniform, ConnectionSampling::Collision,
        false},
+      {"mixture + collision", DistanceSampling::Mixture, ConnectionSampling::Collision, false},
       {"mfp + collision", DistanceSampling::Mfp, ConnectionSampling::Collision, false},
   };
   const int n = static_cast<int>(sizeof(configs) / sizeof(configs[0]));

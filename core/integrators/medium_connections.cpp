@@ -44,15 +44,25 @@ AngularTarget angular_target(const TimeAxis& axis, const Light& L, const Vec3& x
 }
 }  // namespace
 
+double VolPathIntegrator::mixture_share(const Medium& med, const Vec3& x, double t) const {
+  return mixture_tu_probability(spread_sigma_t(med, x), med.eta_at(x),
+                                kSpeedOfLight * (t_cut_ - t));
+}
+
 VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& med, const Vec3& x,
                                                                  double t, double u) const {
   DirectionMix mix;
   mix.u = u;
   mix.t = t;
   mix.eta = med.eta_at(x);
-  // The segment length the next distance draw u gives at x's own coefficients.
-  const double e = unit_exponential(u);  // the same draw as the tracker's
-  if (med.strategy.kind == DistanceSampling::TimeUniform) {
+  // The segment length the next distance draw u gives at x's own coefficients (a mixture splits
+  // u into its pick and the draw, as the tracker will).
+  double u_dist = u;
+  const bool tu = med.strategy.kind == DistanceSampling::Mixture
+                      ? mixture_pick(u, mixture_share(med, x, t), u_dist)
+                      : med.strategy.kind == DistanceSampling::TimeUniform;
+  const double e = unit_exponential(u_dist);  // the same draw as the tracker's
+  if (tu) {
     mix.r_aux = e / (med.strategy.lambda * mix.eta);
   } else {
     const double sigma_t =

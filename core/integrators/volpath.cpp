@@ -188,7 +188,10 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       t += opl * t_seg;
       if (t > t_cut_ || beta.is_black()) break;
     } else {
-      const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next);
+      const double q_tu = med.strategy.kind == DistanceSampling::Mixture && med.interacts()
+                              ? mixture_share(med, ray.o, t)
+                              : 0.0;
+      const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next, q_tu);
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
       const ConnectedSegment segment = plan_segment(med, ray, s_surf);
       if (segment.active && depth < max_depth_)

@@ -49,6 +49,8 @@ class VolPathIntegrator {
     double valid_pmf = 0;  ///< total pick probability of the point lights whose window is reachable
   };
   DirectionMix direction_mix(const Medium& med, const Vec3& x, double t, double u) const;
+  /// Time-uniform share of a `mixture` medium's distance draw on a segment from x at path time t.
+  double mixture_share(const Medium& med, const Vec3& x, double t) const;
   /// Density (per steradian) of direction w at x: phase alone, or the phase/angular mixture.
   double direction_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g,
                        const Vec3& w) const;
