@@ -87,7 +87,8 @@ std::string corridor_scene(double sigma_t, double albedo, double half) {
     "shapes": [ { "type": "box", "min": [%g, %g, -2000], "max": [%g, %g, 0], "medium": "fog" } ],
     "lights": [ { "type": "point", "position": [0, %g, 30], "intensity": 1000 } ]
   })",
-                fov, (1 - albedo) * sigma_t, albedo * sigma_t, -half, -half, half, half, 0.75 * half);
+                fov, (1 - albedo) * sigma_t, albedo * sigma_t, -half, -half, half, half,
+                0.75 * half);
   return buf;
 }
 
@@ -204,7 +205,8 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
               static_cast<double>(stats[static_cast<size_t>(c_ref)].medium_events) /
                   static_cast<double>(stats[static_cast<size_t>(c_ref)].paths));
   std::printf("  %-27s %10s %12s %12s %12s %18s\n", "configuration", "paths/s", "median eff.",
-              "late eff.", "film eff.", !long_ref.empty() ? "total vs reference" : "total vs pooled");
+              "late eff.", "film eff.",
+              !long_ref.empty() ? "total vs reference" : "total vs pooled");
   for (int k = 0; k < n; ++k) {
     const double t = median(secs[static_cast<size_t>(k)]);
     const std::vector<double> mse = mse_of(k);

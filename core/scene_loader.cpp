@@ -744,17 +744,18 @@ class Loader {
     } else {
       m.sampling = DistanceSampling::Mfp;  // the default for scene files (docs/scene-format.md)
     }
-    const std::string uses =
-        std::string("; this medium uses \"") +
-        (m.sampling == DistanceSampling::Mfp           ? "mfp"
-         : m.sampling == DistanceSampling::TimeUniform ? "time_uniform"
-         : m.sampling == DistanceSampling::Mis         ? "mis"
-                                                       : "mixture") +
-        "\"" + (s ? "" : " (the default)");
+    const std::string uses = std::string("; this medium uses \"") +
+                             (m.sampling == DistanceSampling::Mfp           ? "mfp"
+                              : m.sampling == DistanceSampling::TimeUniform ? "time_uniform"
+                              : m.sampling == DistanceSampling::Mis         ? "mis"
+                                                                            : "mixture") +
+                             "\"" + (s ? "" : " (the default)");
     if (const Json* r = find(o, "time_uniform_rate")) {
       if (m.sampling == DistanceSampling::Mfp)
         fail(at(mp, "time_uniform_rate"),
-             "only applies with \"distance_sampling\": \"time_uniform\", \"mis\" or \"mixture\"" + uses, *r);
+             "only applies with \"distance_sampling\": \"time_uniform\", \"mis\" or \"mixture\"" +
+                 uses,
+             *r);
       m.time_uniform_rate =
           not_tiny(number(*r, at(mp, "time_uniform_rate"), above(0)), kMinRate, at(mp, "time_uniform_rate"), *r);
     }

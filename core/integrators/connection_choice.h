@@ -1,8 +1,8 @@
 #pragma once
 // Where segment connections pay (connection_sampling "auto"). Next-event estimation at the
 // path's collisions has, per unit time, the lowest error on typical pixels (femto-bench-sampling),
-// but near a point light its 1/r^2 gives fireflies; equiangular and line-to-point connections
-// remove them at a higher cost per segment. So a segment uses connections only when the light's
+// but near a point light its 1/r^2 gives fireflies; an equiangular connection removes them at a
+// higher cost per segment. So a segment uses connections only when the light's
 // direct term along it has a peak much narrower than the spread of the collisions that sample it:
 // peak width w = the light's distance from the line (foot on the segment), from the start (foot
 // behind) or from the end (foot beyond); spread = min(segment length, mean free path).

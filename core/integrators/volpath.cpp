@@ -56,8 +56,7 @@ VolPathIntegrator::ConnectedSegment VolPathIntegrator::plan_segment(const Medium
                                                                     const Ray& ray,
                                                                     double s_surf) const {
   ConnectedSegment segment;
-  if (med.connection == ConnectionSampling::Collision || point_lights_.empty() ||
-      !med.interacts())
+  if (med.connection == ConnectionSampling::Collision || point_lights_.empty() || !med.interacts())
     return segment;
   segment.ray = ray;
   segment.s_surf = s_surf;

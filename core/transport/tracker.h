@@ -41,8 +41,8 @@ class MediumTracker {
   /// `u_main` >= 0 replaces the main distance draw (angular direction sampling draws it early);
   /// `q_tu` is the time-uniform share of a `mixture` medium (0: mean free path, as light paths
   /// use).
-  MediumSample sample(const Medium& med, const Ray& ray, double s_max, Rng& rng,
-                      double u_main = -1, double q_tu = 0) const;
+  MediumSample sample(const Medium& med, const Ray& ray, double s_max, Rng& rng, double u_main = -1,
+                      double q_tu = 0) const;
   /// Transmittance and time of flight of a straight connection x -> x + dist * w starting in
   /// medium m, passing through index-matched boundaries; false if a surface with a material
   /// blocks it.
