@@ -44,13 +44,18 @@ AngularTarget angular_target(const TimeAxis& axis, const Light& L, const Vec3& x
 }
 }  // namespace
 
-double VolPathIntegrator::mixture_share(const Medium& med, const Vec3& x, double t) const {
+double VolPathIntegrator::mixture_share(const Medium& med, const Vec3& x, double t,
+                                        int depth) const {
+  // Divided by the vertices so far: the weights 1 / (1 - q) then compound to a power of the
+  // path length, not an exponential (dense media have many vertices per path).
   return mixture_tu_probability(spread_sigma_t(med, x), med.eta_at(x),
-                                kSpeedOfLight * (t_cut_ - t));
+                                kSpeedOfLight * (t_cut_ - t)) /
+         (1.0 + depth);
 }
 
 VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& med, const Vec3& x,
-                                                                 double t, double u) const {
+                                                                 double t, double u,
+                                                                 int depth) const {
   DirectionMix mix;
   mix.u = u;
   mix.t = t;
@@ -59,7 +64,7 @@ VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& m
   // u into its pick and the draw, as the tracker will).
   double u_dist = u;
   const bool tu = med.strategy.kind == DistanceSampling::Mixture
-                      ? mixture_pick(u, mixture_share(med, x, t), u_dist)
+                      ? mixture_pick(u, mixture_share(med, x, t, depth), u_dist)
                       : med.strategy.kind == DistanceSampling::TimeUniform;
   const double e = unit_exponential(u_dist);  // the same draw as the tracker's
   if (tu) {

@@ -48,9 +48,12 @@ class VolPathIntegrator {
     double t = 0;          ///< path time at the vertex, ps
     double valid_pmf = 0;  ///< total pick probability of the point lights whose window is reachable
   };
-  DirectionMix direction_mix(const Medium& med, const Vec3& x, double t, double u) const;
-  /// Time-uniform share of a `mixture` medium's distance draw on a segment from x at path time t.
-  double mixture_share(const Medium& med, const Vec3& x, double t) const;
+  /// `depth`: the vertices before the next segment (for a mixture's share).
+  DirectionMix direction_mix(const Medium& med, const Vec3& x, double t, double u,
+                             int depth) const;
+  /// Time-uniform share of a `mixture` medium's distance draw on a segment from x at path time t
+  /// after `depth` vertices.
+  double mixture_share(const Medium& med, const Vec3& x, double t, int depth) const;
   /// Density (per steradian) of direction w at x: phase alone, or the phase/angular mixture.
   double direction_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g,
                        const Vec3& w) const;
