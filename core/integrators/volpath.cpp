@@ -202,13 +202,15 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       u_next = angular ? rng.uniform() : -1.0;
       const double t_main = t + ms.main.opl * t_dropped;
       const DirectionMix mix_main =
-          angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next, depth + 1) : DirectionMix{};
+          angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next, depth + 1)
+                  : DirectionMix{};
       if (ms.extra.collided && depth < max_depth_) {
         // The time-uniform collision of MIS: next-event estimation only (the path goes on from
         // the mean-free-path collision).
         const Vec3 x2 = ray.at(ms.extra.s);
         const double t2 = t + ms.extra.opl * t_dropped;
-        const DirectionMix mix2 = angular ? direction_mix(med, x2, t2, u_next, depth + 1) : DirectionMix{};
+        const DirectionMix mix2 =
+            angular ? direction_mix(med, x2, t2, u_next, depth + 1) : DirectionMix{};
         estimate_direct_medium(x2, m, ray.d, med.g(),
                                beta * (MediumTracker::albedo_at(med, x2) * ms.extra_nee_weight), t2,
                                angular ? &mix2 : nullptr, segment, rng, acc, stats);

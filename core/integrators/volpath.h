@@ -49,8 +49,7 @@ class VolPathIntegrator {
     double valid_pmf = 0;  ///< total pick probability of the point lights whose window is reachable
   };
   /// `depth`: the vertices before the next segment (for a mixture's share).
-  DirectionMix direction_mix(const Medium& med, const Vec3& x, double t, double u,
-                             int depth) const;
+  DirectionMix direction_mix(const Medium& med, const Vec3& x, double t, double u, int depth) const;
   /// Time-uniform share of a `mixture` medium's distance draw on a segment from x at path time t
   /// after `depth` vertices.
   double mixture_share(const Medium& med, const Vec3& x, double t, int depth) const;
