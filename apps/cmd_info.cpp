@@ -53,8 +53,12 @@ std::string sampling(const MediumDesc& m) {
   switch (m.sampling) {
     case DistanceSampling::Mfp: return "mfp";
     case DistanceSampling::TimeUniform:
-      return "time_uniform, rate " +
-             (m.time_uniform_rate > 0 ? g6(m.time_uniform_rate) + " /mm OPL" : std::string("automatic"));
+      return "time_uniform, rate " + (m.time_uniform_rate > 0 ? g6(m.time_uniform_rate) + " /mm OPL"
+                                                              : std::string("automatic"));
+    case DistanceSampling::Mixture:
+      return "mixture (one-sample MIS of mfp and time_uniform per segment), time-uniform rate " +
+             (m.time_uniform_rate > 0 ? g6(m.time_uniform_rate) + " /mm OPL"
+                                      : std::string("automatic"));
     case DistanceSampling::Mis:
       return std::string("mis (") + (m.mis_heuristic == MisHeuristic::Balance ? "balance" : "power") +
              " heuristic), time-uniform rate " +

@@ -36,8 +36,10 @@ bool parse_render_flag(cli::Args& args, const std::string& a, RenderOverrides& o
       o.sampling = DistanceSampling::TimeUniform;
     else if (v == "mis")
       o.sampling = DistanceSampling::Mis;
+    else if (v == "mixture")
+      o.sampling = DistanceSampling::Mixture;
     else
-      args.fail("expected mfp, time_uniform or mis", v);
+      args.fail("expected mfp, time_uniform, mis or mixture", v);
   } else if (a == "--connection-sampling") {
     const std::string v = args.value();
     if (v == "collision")

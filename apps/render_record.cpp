@@ -125,7 +125,7 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
 }
 
 const char* sampling_name(DistanceSampling s) {
-  const char* names[] = {"mfp", "time_uniform", "mis"};
+  const char* names[] = {"mfp", "time_uniform", "mis", "mixture"};
   return names[static_cast<int>(s)];
 }
 
@@ -200,13 +200,12 @@ nlohmann::json render_info(const Scene& scene, const std::string& scene_text, co
                       {"russian_roulette", false}};
   nlohmann::json media = nlohmann::json::array();
   {
-    const char* names[] = {"mfp", "time_uniform", "mis"};
     for (size_t i = 0; i < scene.desc().media.size(); ++i) {
       const MediumDesc& md = scene.desc().media[i];
       const Medium& rm = scene.media()[i];
       nlohmann::json e = {{"name", md.name},
                           {"type", md.type == MediumDesc::Type::Vdb ? "vdb" : "homogeneous"},
-                          {"distance_sampling", names[static_cast<int>(md.sampling)]}};
+                          {"distance_sampling", sampling_name(md.sampling)}};
       if (md.sampling != DistanceSampling::Mfp) e["time_uniform_rate_per_mm_opl"] = rm.strategy.lambda;
       if (md.sampling == DistanceSampling::Mis)
         e["mis_heuristic"] = md.mis_heuristic == MisHeuristic::Power ? "power" : "balance";

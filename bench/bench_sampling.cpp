@@ -35,17 +35,26 @@ struct BenchScene {
   const char* name;
   std::string json;
   int spp;  ///< per render, so that a render takes a fraction of a second
+  /// Cells count when the pooled estimate exceeds this fraction of the film's peak (0: every
+  /// cell with light, for scenes whose late frames are many decades dimmer than the first).
+  double min_signal = 0.01;
+  /// > 0: errors are measured against one long reference render (`mis + mis`, this many times
+  /// the spp, seeds of its own) instead of the mean of the other configurations, whose noise in
+  /// dim late cells would swamp the errors of the good estimators.
+  int reference_factor = 0;
 };
 
-/// A box of homogeneous medium (half-width `half`) with a point light inside it, seen from 6
-/// half-widths away; the window opens when light can first come back from the front face.
+/// A box of homogeneous medium (half-width `half`) with a point light at (0.2, 0.3, light_z) x
+/// half, seen from 6 half-widths away along +z; the window opens when light can first come back
+/// from the front face. light_z < 1: the light is inside the medium; > 1: outside, in front of
+/// the face the camera sees (a source shining into the medium, as in a reflectance measurement).
 std::string box_scene(double half, double sigma_a, double sigma_s, double g, double eta,
-                      double bin_ps) {
+                      double bin_ps, double light_z = 0.1) {
   const double t_start = 5.0 * half / 0.299792458;
   char light[256];
   std::snprintf(light, sizeof(light),
                 R"({ "type": "point", "position": [%g, %g, %g], "intensity": 100 })", 0.2 * half,
-                0.3 * half, 0.1 * half);
+                0.3 * half, light_z * half);
   char buf[1024];
   std::snprintf(buf, sizeof(buf), R"({
     "camera": { "type": "perspective", "position": [0, 0, %g], "look_at": [0, 0, 0], "fov": 30,
@@ -57,6 +66,29 @@ std::string box_scene(double half, double sigma_a, double sigma_s, double g, dou
   })",
                 6 * half, t_start, bin_ps, sigma_a, sigma_s, g, eta, -half, -half, -half, half, half, half,
                 light);
+  return buf;
+}
+
+/// The time-uniform regime: a 2 m long corridor of thin fog (extinction sigma_t, given albedo,
+/// g 0.3, square section of half-width `half`) seen down its length by a camera whose field of
+/// view stays inside it, a point light beside the camera outside the fog, a 12 ns window. A frame
+/// at time t sees light scattered about c t / 2 down the corridor, so the last third of the
+/// window lies 1200-1800 mm away (4.8-7.2 mean free paths at sigma_t = 0.004/mm), where
+/// mean-free-path sampling rarely puts a vertex; light that leaves the corridor's side does not
+/// come back. Every cell with light counts (the late frames are many decades dimmer).
+std::string corridor_scene(double sigma_t, double albedo, double half) {
+  const double fov = 2.0 * std::atan(0.8 * half / 2050.0) * 180.0 / 3.14159265358979;
+  char buf[1024];
+  std::snprintf(buf, sizeof(buf), R"({
+    "camera": { "type": "perspective", "position": [0, 0, 50], "look_at": [0, 0, -1000],
+                "fov": %g, "resolution": [8, 8] },
+    "time": { "t_start": 0, "bin_width": 80, "bins": 150 },
+    "media": { "fog": { "type": "homogeneous", "sigma_a": %g, "sigma_s": %g, "g": 0.3 } },
+    "shapes": [ { "type": "box", "min": [%g, %g, -2000], "max": [%g, %g, 0], "medium": "fog" } ],
+    "lights": [ { "type": "point", "position": [0, %g, 30], "intensity": 1000 } ]
+  })",
+                fov, (1 - albedo) * sigma_t, albedo * sigma_t, -half, -half, half, half,
+                0.75 * half);
   return buf;
 }
 
@@ -91,6 +123,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
       {"mis + collision", DistanceSampling::Mis, ConnectionSampling::Collision, false},
       {"time_uniform + collision", DistanceSampling::TimeUniform, ConnectionSampling::Collision,
        false},
+      {"mixture + collision", DistanceSampling::Mixture, ConnectionSampling::Collision, false},
       {"mfp + collision", DistanceSampling::Mfp, ConnectionSampling::Collision, false},
   };
   const int n = static_cast<int>(sizeof(configs) / sizeof(configs[0]));
@@ -136,11 +169,27 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
   std::vector<double> pooled(cells, 0.0);
   for (int k = 0; k < n; ++k)
     for (size_t i = 0; i < cells; ++i) pooled[i] += mean[static_cast<size_t>(k)][i] / n;
+  std::vector<double> long_ref;
+  if (bs.reference_factor > 0) {
+    RenderOptions opt;
+    opt.spp = spp * bs.reference_factor;
+    opt.threads = 0;
+    opt.quiet = true;
+    opt.seed = 1000003;
+    const RenderResult res = render(*scenes[1], opt);  // mis + mis
+    long_ref.resize(cells);
+    for (size_t i = 0; i < cells; ++i)
+      long_ref[i] = static_cast<double>(res.film.transient()[3 * i]) +
+                    res.film.transient()[3 * i + 1] + res.film.transient()[3 * i + 2];
+    pooled = long_ref;
+  }
   const double peak = percentile(pooled, 0.999);
   auto mse_of = [&](int k) {
     std::vector<double> mse(cells, 0.0);
     for (size_t i = 0; i < cells; ++i) {
-      const double ref = (pooled[i] * n - mean[static_cast<size_t>(k)][i]) / (n - 1);
+      const double ref = !long_ref.empty()
+                             ? long_ref[i]
+                             : (pooled[i] * n - mean[static_cast<size_t>(k)][i]) / (n - 1);
       for (const auto& f : films[static_cast<size_t>(k)])
         mse[i] += (f[i] - ref) * (f[i] - ref) / reps;
     }
@@ -156,7 +205,8 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
               static_cast<double>(stats[static_cast<size_t>(c_ref)].medium_events) /
                   static_cast<double>(stats[static_cast<size_t>(c_ref)].paths));
   std::printf("  %-27s %10s %12s %12s %12s %18s\n", "configuration", "paths/s", "median eff.",
-              "late eff.", "film eff.", "total vs pooled");
+              "late eff.", "film eff.",
+              !long_ref.empty() ? "total vs reference" : "total vs pooled");
   for (int k = 0; k < n; ++k) {
     const double t = median(secs[static_cast<size_t>(k)]);
     const std::vector<double> mse = mse_of(k);
@@ -165,7 +215,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
     for (size_t i = 0; i < cells; ++i) {
       sum_mse += mse[i];
       sum_mse_c += mse_c[i];
-      if (!(pooled[i] > 0.01 * peak && mse[i] > 0 && mse_c[i] > 0)) continue;
+      if (!(pooled[i] > bs.min_signal * peak && mse[i] > 0 && mse_c[i] > 0)) continue;
       const double e = (mse_c[i] * time_c) / (mse[i] * t);
       all.push_back(e);
       if (static_cast<int>(i % static_cast<size_t>(bins)) >= 2 * bins / 3) late.push_back(e);
@@ -222,8 +272,10 @@ int main(int argc, char** argv) {
       // 20 mm box, mean free path 1 mm, 300 ps.
       {"dense fog", box_scene(10, 0.2, 0.8, 0.3, 1.0, 2.0), 64},
       // 20 mm block of tissue: mu_s = 10/mm, g = 0.9 (mu_s' = 1/mm), mu_a = 0.01/mm, n = 1.37,
-      // 150 ps.
-      {"tissue", box_scene(10, 0.01, 10.0, 0.9, 1.37, 1.0), 4},
+      // 150 ps; the source 2 mm in front of the face the camera sees (time-domain diffuse
+      // reflectance). A source inside would give collision next-event estimation infinite
+      // variance (1/r^2 at the light), and every total would be meaningless.
+      {"tissue", box_scene(10, 0.01, 10.0, 0.9, 1.37, 1.0, 1.2), 16},
       // A closed 400 mm room of grey walls (albedo 0.8) in very thin fog (mean free path 2 m),
       // a point light, the camera inside; a 12 ns window: the late frames are light that has
       // bounced and scattered many times (the regime where time-uniform sampling should pay).
@@ -239,6 +291,11 @@ int main(int argc, char** argv) {
         "lights": [ { "type": "point", "position": [40, 60, -30], "intensity": 1000 } ]
       })",
        16},
+      // The time-uniform regime (corridor_scene): a narrow corridor of grey fog (albedo 0.5),
+      // and a wide one of brighter fog (albedo 0.8) whose multiply scattered light also reaches
+      // the late frames.
+      {"fog corridor, long window", corridor_scene(0.004, 0.5, 5), 2048, 0.0, 32},
+      {"wide fog corridor, long window", corridor_scene(0.004, 0.8, 20), 2048, 0.0, 32},
   };
   const std::string cloud = "data/volumes/cloud.vdb";
   if (std::filesystem::exists(cloud)) {

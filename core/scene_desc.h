@@ -50,7 +50,8 @@ struct MaterialDesc {
 enum class DistanceSampling {
   Mfp,          ///< mean-free-path: p(s) = sigma_t(s) exp(-tau(s))
   TimeUniform,  ///< exponential in optical path length with rate lambda (seed 000 Sec. 5.1)
-  Mis           ///< both, combined by multiple importance sampling
+  Mis,          ///< both, combined by multiple importance sampling
+  Mixture       ///< one of the two per segment, picked by the remaining window (one-sample MIS)
 };
 enum class MisHeuristic { Balance, Power };
 

@@ -94,6 +94,79 @@ DistanceEvent sample_distance(Segments& segments, const DistanceStrategy& st, do
   return ev;
 }
 
+/// The time-uniform share q of the `mixture` strategy on a segment that starts with budget_opl
+/// mm of optical path left before the window closes, in a medium of extinction sigma_t and index
+/// eta there. x = sigma_t budget / eta is how many mean free paths the remaining window spans:
+/// mean-free-path vertices cover a window shorter than a mean free path about evenly (q -> 0),
+/// and leave a window of many mean free paths empty beyond the first ones (q -> 1/2). Capping q
+/// at 1/2 caps every weight at 1 / (1 - q) <= 2.
+inline double mixture_tu_probability(double sigma_t, double eta, double budget_opl) {
+  if (!(sigma_t > 0) || !(budget_opl > 0)) return 0.0;
+  const double x = sigma_t * budget_opl / eta;
+  return std::isfinite(x) ? 0.5 * x / (1.0 + x) : 0.5;
+}
+
+/// Splits the one uniform u of a mixture segment into the pick (time-uniform when u < q) and the
+/// uniform of the picked strategy's draw (one uniform, so angular direction sampling can draw it
+/// ahead).
+inline bool mixture_pick(double u, double q, double& u_dist) {
+  if (u < q) {
+    u_dist = u / q;
+    return true;
+  }
+  u_dist = (u - q) / (1.0 - q);
+  return false;
+}
+
+/// Density of the mixture at a collision with optical depth tau, optical path opl, extinction
+/// sigma_t and index eta, and its probability of passing a range of optical depth tau and path
+/// opl.
+inline double mixture_pdf(double q, double lambda, double tau, double opl, double sigma_t,
+                          double eta) {
+  return (1.0 - q) * sigma_t * std::exp(-tau) + q * lambda * eta * std::exp(-lambda * opl);
+}
+inline double mixture_pass(double q, double lambda, double tau, double opl) {
+  return (1.0 - q) * std::exp(-tau) + q * std::exp(-lambda * opl);
+}
+
+/// One-sample MIS of the two strategies (kind Mixture): time-uniform with probability q_tu,
+/// mean free path otherwise (mixture_pick splits u), and the path continues from the collision.
+/// Weight f / (mixture density): sigma_t T / mixture_pdf at a collision (at most 1 / (1 - q),
+/// so no heavy tail in dense media, unlike time-uniform alone), T / mixture_pass past the end.
+template <class Segments>
+DistanceEvent sample_distance_mixture(Segments& segments, const DistanceStrategy& st, double q_tu,
+                                      double u) {
+  double u_dist;
+  const bool tu = mixture_pick(u, q_tu, u_dist);
+  const double target = tu ? unit_exponential(u_dist) / st.lambda : unit_exponential(u_dist);
+  DistanceEvent ev;
+  MediumSegment seg;
+  while (segments.next(seg)) {
+    const double L = seg.s1 - seg.s0;
+    const Poly3& driver = tu ? seg.eta : seg.sigma_t;
+    const double part = segment_integral(driver, L);
+    const double done = tu ? ev.opl : ev.tau;
+    if (done + part >= target && part > 0) {
+      const double x = invert_integral(driver, target - done, L);
+      ev.collided = true;
+      ev.s = seg.s0 + x;
+      ev.tau += seg.sigma_t.integral(x);
+      ev.opl += seg.eta.integral(x);
+      ev.sigma_t = std::fmax(0.0, seg.sigma_t(x));
+      ev.eta = seg.eta(x);
+      const double p = mixture_pdf(q_tu, st.lambda, ev.tau, ev.opl, ev.sigma_t, ev.eta);
+      ev.weight = p > 0 ? ev.sigma_t * std::exp(-ev.tau) / p : 0.0;
+      return ev;
+    }
+    ev.s = seg.s1;
+    ev.tau += segment_integral(seg.sigma_t, L);
+    ev.opl += segment_integral(seg.eta, L);
+  }
+  const double P = mixture_pass(q_tu, st.lambda, ev.tau, ev.opl);
+  ev.weight = P > 0 ? std::exp(-ev.tau) / P : 0.0;
+  return ev;
+}
+
 /// Both strategies at once, for MIS (kind Mis): `mfp` continues the path (weight 1 as above),
 /// `tu` is a second collision sampled uniformly in time. Each collision also gets `nee_weight`:
 /// its MIS weight times f / p, to weight next-event estimation at that point (multi-sample MIS

@@ -138,14 +138,18 @@ TEST_CASE("grid medium: walker integrals equal an independent quadrature on obli
 namespace {
 // Samples many distances and returns the chi-square p-value against the strategy's own pdf,
 // computed from reference integrals (bins over [0, s_max] plus a "no collision" cell).
+// A mixture (kind Mixture) samples with time-uniform share q_sample and is tested against the
+// pdf of share q_pdf.
 double distance_chi2(const GridMedium& m, const VolumeData& v, const Ray& ray, double s_max,
-                     const DistanceStrategy& st, int n) {
+                     const DistanceStrategy& st, int n, double q_sample = 0, double q_pdf = 0) {
   const int bins = 40;
   std::vector<double> observed(bins + 1, 0.0), expected(bins + 1, 0.0);
   Rng rng(99, 1);
+  const bool mixture = st.kind == DistanceSampling::Mixture;
   for (int i = 0; i < n; ++i) {
     GridMedium::Walker w(m, ray, s_max);
-    const DistanceEvent ev = sample_distance(w, st, rng.uniform());
+    const DistanceEvent ev = mixture ? sample_distance_mixture(w, st, q_sample, rng.uniform())
+                                     : sample_distance(w, st, rng.uniform());
     if (!ev.collided) observed[bins] += 1;
     else observed[std::min(bins - 1, static_cast<int>(ev.s / s_max * bins))] += 1;
   }
@@ -154,7 +158,9 @@ double distance_chi2(const GridMedium& m, const VolumeData& v, const Ray& ray, d
   for (int b = 0; b < bins; ++b) {
     double tau, opl;
     reference_integrals(m, v, ray, s_max * (b + 1) / bins, tau, opl);
-    const double survival = mfp ? std::exp(-tau) : std::exp(-st.lambda * opl);
+    const double survival = mixture ? mixture_pass(q_pdf, st.lambda, tau, opl)
+                            : mfp   ? std::exp(-tau)
+                                    : std::exp(-st.lambda * opl);
     expected[b] = n * (prev_survival - survival);
     prev_survival = survival;
   }
@@ -164,7 +170,8 @@ double distance_chi2(const GridMedium& m, const VolumeData& v, const Ray& ray, d
 }  // namespace
 
 // Catches: time-uniform sampling done in distance instead of optical path length (wrong when eta
-// varies), wrong inversion of the OPL or optical-depth integral inside a cell.
+// varies), wrong inversion of the OPL or optical-depth integral inside a cell, and a mixture
+// whose pick or split of the uniform does not give its stated density.
 TEST_CASE("grid medium: sampled distances follow their pdfs (chi-square)", "[grid][chi2]") {
   for (bool trilinear : {false, true}) {
     const VolumeData v = make_volume(10, 10, 10, 1.0, {0, 0, 0}, 21, 1.0, 3.0);
@@ -175,6 +182,10 @@ TEST_CASE("grid medium: sampled distances follow their pdfs (chi-square)", "[gri
     INFO("trilinear " << trilinear);
     CHECK(distance_chi2(m, v, ray, 16.0, tu, 200000) > 1e-3);
     CHECK(distance_chi2(m, v, ray, 16.0, mfp, 200000) > 1e-3);
+    // The one-sample mixture against its own pdf, and (power) against a mixture of another share.
+    DistanceStrategy mix{DistanceSampling::Mixture, 0.08, MisHeuristic::Balance};
+    CHECK(distance_chi2(m, v, ray, 16.0, mix, 200000, 0.35, 0.35) > 1e-3);
+    CHECK(distance_chi2(m, v, ray, 16.0, mix, 200000, 0.35, 0.25) < 1e-6);
     // Power check: sampling in distance with the same lambda (eta ignored) must be rejected.
     VolumeData v1 = v;
     for (auto& e : v1.eta.v) e = 1.0f;
@@ -206,7 +217,8 @@ TEST_CASE("grid medium: sampled distances follow their pdfs (chi-square)", "[gri
 }
 
 // Catches: MIS weights that do not sum to one (biased estimates), pdfs of the other strategy
-// evaluated at the wrong point, wrong pass-through probabilities.
+// evaluated at the wrong point, wrong pass-through probabilities (also of the one-sample
+// mixture: a weight that is not f over the mixture density).
 TEST_CASE("grid medium: every strategy estimates collision and transmission integrals without bias",
           "[grid]") {
   const VolumeData v = make_volume(8, 8, 8, 1.0, {0, 0, 0}, 33, 1.0, 2.5);
@@ -229,7 +241,8 @@ TEST_CASE("grid medium: every strategy estimates collision and transmission inte
       {DistanceSampling::Mfp, 0.0, MisHeuristic::Balance},
       {DistanceSampling::TimeUniform, 0.05, MisHeuristic::Balance},
       {DistanceSampling::Mis, 0.05, MisHeuristic::Balance},
-      {DistanceSampling::Mis, 0.05, MisHeuristic::Power}};
+      {DistanceSampling::Mis, 0.05, MisHeuristic::Power},
+      {DistanceSampling::Mixture, 0.05, MisHeuristic::Balance}};
   for (const auto& st : strategies) {
     Rng rng(17, static_cast<uint64_t>(st.kind) * 2 + static_cast<uint64_t>(st.heuristic));
     const int n = 400000;
@@ -245,7 +258,10 @@ TEST_CASE("grid medium: every strategy estimates collision and transmission inte
         if (pr.tu.collided) c += pr.tu_nee_weight * pr.tu.s;
         if (!pr.mfp.collided) t = pr.mfp.weight;
       } else {
-        const DistanceEvent ev = sample_distance(w, st, rng.uniform());
+        // The mixture: one-sample MIS, time-uniform share 0.35 (its weight is f / mixture pdf).
+        const DistanceEvent ev = st.kind == DistanceSampling::Mixture
+                                     ? sample_distance_mixture(w, st, 0.35, rng.uniform())
+                                     : sample_distance(w, st, rng.uniform());
         c = ev.collided ? ev.weight * ev.s : 0.0;
         t = ev.collided ? 0.0 : ev.weight;
       }      sum_c += c;

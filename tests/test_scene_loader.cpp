@@ -711,6 +711,11 @@ TEST_CASE("scene loader: vdb media and distance-sampling keys", "[scene_loader]"
   CHECK(s.media[1].sampling == femto::DistanceSampling::Mfp);
   j["media"]["air"]["connection_sampling"] = "auto";
   CHECK(load(j).media[1].connection == femto::ConnectionSampling::Auto);
+  // The one-sample mixture takes a time-uniform rate like time_uniform and mis.
+  j["media"]["air"]["distance_sampling"] = "mixture";
+  j["media"]["air"]["time_uniform_rate"] = 0.5;
+  CHECK(load(j).media[1].sampling == femto::DistanceSampling::Mixture);
+  CHECK(load(j).media[1].time_uniform_rate == 0.5);
 
   // Defaults of a minimal vdb medium.
   const SceneDesc d = load(vdb_scene(minimal_vdb()));

@@ -98,8 +98,10 @@ TEST_CASE("segment connections match the single-scattering answer bin by bin", "
 
 // Catches: segment connections and angular sampling that are biased with multiple scattering,
 // surfaces, a spot light beside an area light (MIS with the phase/angular mixture), the
-// time-uniform + MIS distance sampler (shared r_aux), unwarped camera segments, and a
-// heterogeneous voxel medium with varying index. Reference: collision NEE + phase sampling.
+// time-uniform + MIS distance sampler (shared r_aux), the one-sample mixture continuing paths
+// (its weights), unwarped camera segments, and a heterogeneous
+// voxel medium with varying index. Reference: collision NEE + phase sampling (mean free path
+// for the mixture).
 TEST_CASE("time-targeted sampling agrees with the reference estimator with multiple scattering",
           "[time-sampling][statistical]") {
   TempDir tmp("femto_time_sampling");
@@ -118,14 +120,14 @@ TEST_CASE("time-targeted sampling agrees with the reference estimator with multi
   const std::string vdb = (tmp.dir / "hetero.vdb").string();
   write_volume(vdb, density, nullptr, &eta, 2.5, {-20, -20, -20});
 
-  for (int variant = 0; variant < 3; ++variant) {
+  for (int variant = 0; variant < 5; ++variant) {
     SceneDesc d;
     d.source = "time sampling";
     d.camera = ortho_camera({0, 0, 40}, {0, 0, 0}, 30, 4, 3);
     d.time.t_start_ps = 60;
     d.time.bin_width_ps = 20;
     d.time.bins = 14;
-    if (variant == 0) {
+    if (variant == 0 || variant == 3) {
       d.media.push_back(medium("fog", 0.01, 0.12, 0.5, 1.33));  // homogeneous, eta 1.33
     } else if (variant == 1) {
       d.media.push_back(medium("fog", 0.005, 0.08, -0.3, 1.0));
@@ -162,7 +164,12 @@ TEST_CASE("time-targeted sampling agrees with the reference estimator with multi
     point.intensity = RGB(150.0);
     d.lights.push_back(point);
 
+    // Variants 3 and 4: the one-sample mixture (time-uniform share about 0.45 here) continues
+    // the paths, against a mean-free-path reference.
+    const bool mixture = variant >= 3;
+    if (mixture) d.media[0].sampling = DistanceSampling::Mfp;
     const BinStats ref = bin_stats(render_batches(d, 256, 16, /*max_depth=*/8));
+    if (mixture) d.media[0].sampling = DistanceSampling::Mixture;
     for (ConnectionSampling c :
          {ConnectionSampling::LineToPoint, ConnectionSampling::Mis, ConnectionSampling::Auto}) {
       for (DirectionSampling dir : {DirectionSampling::Phase, DirectionSampling::Angular}) {

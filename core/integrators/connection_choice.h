@@ -1,8 +1,8 @@
 #pragma once
 // Where segment connections pay (connection_sampling "auto"). Next-event estimation at the
 // path's collisions has, per unit time, the lowest error on typical pixels (femto-bench-sampling),
-// but near a point light its 1/r^2 gives fireflies; equiangular and line-to-point connections
-// remove them at a higher cost per segment. So a segment uses connections only when the light's
+// but near a point light its 1/r^2 gives fireflies; an equiangular connection removes them at a
+// higher cost per segment. So a segment uses connections only when the light's
 // direct term along it has a peak much narrower than the spread of the collisions that sample it:
 // peak width w = the light's distance from the line (foot on the segment), from the start (foot
 // behind) or from the end (foot beyond); spread = min(segment length, mean free path).
@@ -35,20 +35,22 @@ inline double spread_sigma_t(const Medium& med, const Vec3& o) {
 /// gathers the direct light of the point light at p by segment connections.
 inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, double sigma_t,
                                const Vec3& p) {
-  const double mfp = sigma_t > 0 ? 1.0 / sigma_t : std::numeric_limits<double>::infinity();
-  const double spread = std::fmin(s_full, mfp);
+  // spread = min(s_full, 1 / sigma_t); compared squared and without a division (every segment
+  // asks).
+  const bool mfp_spread = sigma_t * s_full >= 1.0;  // false for a clear medium (also 0 x inf)
   // A clear, endless segment has no collisions to lean on.
-  if (!(spread < std::numeric_limits<double>::infinity())) return true;
+  if (!mfp_spread && !(s_full < std::numeric_limits<double>::infinity())) return true;
   const Vec3 l = p - o;
   const double delta = dot(l, d);
-  double w;
+  double w2;  // the light's squared distance from the segment
   if (delta <= 0.0)
-    w = length(l);
+    w2 = length_squared(l);
   else if (delta >= s_full)
-    w = length(p - (o + d * s_full));
+    w2 = length_squared(p - (o + d * s_full));
   else
-    w = std::sqrt(std::fmax(length_squared(l) - delta * delta, 0.0));
-  return w < kConnectionPeakFraction * spread;
+    w2 = std::fmax(length_squared(l) - delta * delta, 0.0);
+  constexpr double k2 = kConnectionPeakFraction * kConnectionPeakFraction;
+  return mfp_spread ? w2 * sigma_t * sigma_t < k2 : w2 < k2 * s_full * s_full;
 }
 
 /// The auto rule for one light: spot lights always connect (their cone), point lights by

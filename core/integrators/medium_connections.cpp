@@ -44,15 +44,30 @@ AngularTarget angular_target(const TimeAxis& axis, const Light& L, const Vec3& x
 }
 }  // namespace
 
+double VolPathIntegrator::mixture_share(const Medium& med, const Vec3& x, double t,
+                                        int depth) const {
+  // Divided by the vertices so far: the weights 1 / (1 - q) then compound to a power of the
+  // path length, not an exponential (dense media have many vertices per path).
+  return mixture_tu_probability(spread_sigma_t(med, x), med.eta_at(x),
+                                kSpeedOfLight * (t_cut_ - t)) /
+         (1.0 + depth);
+}
+
 VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& med, const Vec3& x,
-                                                                 double t, double u) const {
+                                                                 double t, double u,
+                                                                 int depth) const {
   DirectionMix mix;
   mix.u = u;
   mix.t = t;
   mix.eta = med.eta_at(x);
-  // The segment length the next distance draw u gives at x's own coefficients.
-  const double e = unit_exponential(u);  // the same draw as the tracker's
-  if (med.strategy.kind == DistanceSampling::TimeUniform) {
+  // The segment length the next distance draw u gives at x's own coefficients (a mixture splits
+  // u into its pick and the draw, as the tracker will).
+  double u_dist = u;
+  const bool tu = med.strategy.kind == DistanceSampling::Mixture
+                      ? mixture_pick(u, mixture_share(med, x, t, depth), u_dist)
+                      : med.strategy.kind == DistanceSampling::TimeUniform;
+  const double e = unit_exponential(u_dist);  // the same draw as the tracker's
+  if (tu) {
     mix.r_aux = e / (med.strategy.lambda * mix.eta);
   } else {
     const double sigma_t =
@@ -122,9 +137,11 @@ double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& 
   return pdf > 0 ? hg_eval(dot(d, w), g) / pdf : 0.0;
 }
 
-void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ray, double s_surf,
+void VolPathIntegrator::estimate_segment(const Medium& med, int m, const ConnectedSegment& segment,
                                          const RGB& beta, double t, double t_factor, Rng& rng,
                                          PixelAccumulator& acc, PathStats& stats) const {
+  const Ray& ray = segment.ray;
+  const double s_surf = segment.s_surf;
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
@@ -134,9 +151,7 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
   if (!is_point_like(L)) return;  // area lights and lasers: next-event estimation at collisions
   const Vec3& p = L.position;
   const ConnectionSampling kind = med.connection;
-  if (kind == ConnectionSampling::Auto &&
-      !auto_connects(L, ray.o, ray.d, s_surf, spread_sigma_t(med, ray.o)))
-    return;  // collision next-event estimation's share
+  if (!segment.covers(L)) return;  // collision next-event estimation's share
   // No vertex whose path passes the cut-off: with eta >= 1 the time of s and its connection is at
   // least (s + d) / c with d >= s - |p - o|; an unwarped camera segment counts only d.
   const double l = length(p - ray.o), budget = kSpeedOfLight * (t_cut_ - t);
@@ -144,8 +159,9 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
   const double s_end = std::min(s_surf, reach);
   if (!(s_end > 0)) return;
 
+  // auto connects only where the light term peaks narrowly: equiangular's case (one sample).
   const bool use_eq = kind != ConnectionSampling::LineToPoint;
-  const bool use_lp = kind != ConnectionSampling::Equiangular;
+  const bool use_lp = kind == ConnectionSampling::LineToPoint || kind == ConnectionSampling::Mis;
   const EquiangularSampler eq(ray.o, ray.d, p, 0.0, s_end);
   const double eta0 = med.eta_at(ray.o);
   const LineToPointSampler lp(ray.o, ray.d, p, eta0);
@@ -154,7 +170,8 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Ray& ra
   // Unwarped camera segment: the film time leaves out s, so cover every s whose connection can
   // land.
   if (!(t_factor > 0)) t_b += eta0 * s_end / kSpeedOfLight;
-  const LineToPointSampler::Window win = lp.window(t_a, t_b, 0.0, s_end);
+  const LineToPointSampler::Window win =
+      use_lp ? lp.window(t_a, t_b, 0.0, s_end) : LineToPointSampler::Window{};
   const bool eq_ok = use_eq && eq.valid(), lp_ok = use_lp && win.valid;
 
   auto contribute = [&](double s) {

@@ -1,7 +1,5 @@
 #include "core/integrators/volpath.h"
 
-#include "core/integrators/connection_choice.h"
-
 #include <cmath>
 #include <limits>
 
@@ -51,7 +49,31 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
 
 bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
   if (!active) return false;
-  return all || auto_connects(light, ray.o, ray.d, s_surf, sigma_t);
+  return all || decided || auto_connects(light, ray.o, ray.d, s_surf, sigma_t);
+}
+
+VolPathIntegrator::ConnectedSegment VolPathIntegrator::plan_segment(const Medium& med,
+                                                                    const Ray& ray,
+                                                                    double s_surf) const {
+  ConnectedSegment segment;
+  if (med.connection == ConnectionSampling::Collision || point_lights_.empty() || !med.interacts())
+    return segment;
+  segment.ray = ray;
+  segment.s_surf = s_surf;
+  segment.all = med.connection != ConnectionSampling::Auto;
+  if (segment.all) {
+    segment.active = true;
+    return segment;
+  }
+  segment.sigma_t = spread_sigma_t(med, ray.o);
+  const LightSet& lights = scene_.lights();
+  for (int li : point_lights_)
+    if (auto_connects(lights.light(li), ray.o, ray.d, s_surf, segment.sigma_t)) {
+      segment.active = true;
+      break;
+    }
+  segment.decided = point_lights_.size() == 1;
+  return segment;
 }
 
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
@@ -165,20 +187,14 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       t += opl * t_seg;
       if (t > t_cut_ || beta.is_black()) break;
     } else {
-      const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next);
+      const double q_tu = med.strategy.kind == DistanceSampling::Mixture && med.interacts()
+                              ? mixture_share(med, ray.o, t, depth)
+                              : 0.0;
+      const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next, q_tu);
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
-      const bool segment_connections =
-          med.connection != ConnectionSampling::Collision && !point_lights_.empty();
-      ConnectedSegment segment;
-      segment.active = segment_connections;
-      segment.all = med.connection != ConnectionSampling::Auto;
-      segment.ray = ray;
-      segment.s_surf = s_surf;
-      segment.sigma_t = segment_connections && !segment.all
-                            ? spread_sigma_t(med, ray.o)
-                            : 0.0;
-      if (segment_connections && depth < max_depth_)
-        estimate_segment(med, m, ray, s_surf, beta, t, t_dropped, rng, acc, stats);
+      const ConnectedSegment segment = plan_segment(med, ray, s_surf);
+      if (segment.active && depth < max_depth_)
+        estimate_segment(med, m, segment, beta, t, t_dropped, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every
       // strategy's MIS weight at this segment's vertices sees the same r_aux.
       const bool angular = med.direction == DirectionSampling::Angular && !point_lights_.empty() &&
@@ -186,13 +202,15 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       u_next = angular ? rng.uniform() : -1.0;
       const double t_main = t + ms.main.opl * t_dropped;
       const DirectionMix mix_main =
-          angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next) : DirectionMix{};
+          angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next, depth + 1)
+                  : DirectionMix{};
       if (ms.extra.collided && depth < max_depth_) {
         // The time-uniform collision of MIS: next-event estimation only (the path goes on from
         // the mean-free-path collision).
         const Vec3 x2 = ray.at(ms.extra.s);
         const double t2 = t + ms.extra.opl * t_dropped;
-        const DirectionMix mix2 = angular ? direction_mix(med, x2, t2, u_next) : DirectionMix{};
+        const DirectionMix mix2 =
+            angular ? direction_mix(med, x2, t2, u_next, depth + 1) : DirectionMix{};
         estimate_direct_medium(x2, m, ray.d, med.g(),
                                beta * (MediumTracker::albedo_at(med, x2) * ms.extra_nee_weight), t2,
                                angular ? &mix2 : nullptr, segment, rng, acc, stats);

@@ -48,7 +48,11 @@ class VolPathIntegrator {
     double t = 0;          ///< path time at the vertex, ps
     double valid_pmf = 0;  ///< total pick probability of the point lights whose window is reachable
   };
-  DirectionMix direction_mix(const Medium& med, const Vec3& x, double t, double u) const;
+  /// `depth`: the vertices before the next segment (for a mixture's share).
+  DirectionMix direction_mix(const Medium& med, const Vec3& x, double t, double u, int depth) const;
+  /// Time-uniform share of a `mixture` medium's distance draw on a segment from x at path time t
+  /// after `depth` vertices.
+  double mixture_share(const Medium& med, const Vec3& x, double t, int depth) const;
   /// Density (per steradian) of direction w at x: phase alone, or the phase/angular mixture.
   double direction_pdf(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g,
                        const Vec3& w) const;
@@ -59,12 +63,16 @@ class VolPathIntegrator {
   /// The segment a medium vertex lies on, as far as segment connections are concerned: which
   /// point and spot lights estimate_segment has already gathered along it.
   struct ConnectedSegment {
-    bool active = false;  ///< the medium uses segment connections (and there are point lights)
+    bool active = false;  ///< some point or spot light is gathered by connections on this segment
     bool all = false;     ///< every point light (an explicit strategy), else connection_choice.h
+    bool decided = false;  ///< auto with a single point light: active says it all
     Ray ray;
     double s_surf = 0, sigma_t = 0;
     bool covers(const Light& light) const;
   };
+  /// The segment's connection plan, decided once per segment (and without random draws, so a
+  /// segment that connects nothing costs a few flops).
+  ConnectedSegment plan_segment(const Medium& med, const Ray& ray, double s_surf) const;
   /// Next-event estimation from a medium point x reached along direction d with throughput beta.
   /// `mix` (may be null) gives the direction density for MIS with area lights; point and spot
   /// lights that `segment` covers are left to estimate_segment.
@@ -74,7 +82,7 @@ class VolPathIntegrator {
   /// Direct light from a point or spot light scattered anywhere on [0, s_surf) of `ray` in
   /// medium m (equiangular, line-to-point, or both by MIS). t_factor converts optical path
   /// length to time (0 on the camera segment in unwarp mode).
-  void estimate_segment(const Medium& med, int m, const Ray& ray, double s_surf, const RGB& beta,
+  void estimate_segment(const Medium& med, int m, const ConnectedSegment& segment, const RGB& beta,
                         double t, double t_factor, Rng& rng, PixelAccumulator& acc,
                         PathStats& stats) const;
   void deposit(double t_ps, double sigma_ps, const RGB& value, PixelAccumulator& acc,

@@ -112,22 +112,27 @@ void Loader::connection_sampling(const Json& o, const std::string& mp, MediumDes
 void Loader::distance_sampling(const Json& o, const std::string& mp, MediumDesc& m) const {
   const Json* s = find(o, "distance_sampling");
   if (s) {
-    const std::string v = choice(*s, at(mp, "distance_sampling"), {"mfp", "time_uniform", "mis"});
+    const std::string v =
+        choice(*s, at(mp, "distance_sampling"), {"mfp", "time_uniform", "mis", "mixture"});
     m.sampling = v == "mfp"            ? DistanceSampling::Mfp
                  : v == "time_uniform" ? DistanceSampling::TimeUniform
-                                       : DistanceSampling::Mis;
+                 : v == "mis"          ? DistanceSampling::Mis
+                                       : DistanceSampling::Mixture;
   } else {
     m.sampling = DistanceSampling::Mfp;  // the default for scene files (docs/scene-format.md)
   }
   const std::string uses = std::string("; this medium uses \"") +
                            (m.sampling == DistanceSampling::Mfp           ? "mfp"
                             : m.sampling == DistanceSampling::TimeUniform ? "time_uniform"
-                                                                          : "mis") +
+                            : m.sampling == DistanceSampling::Mis         ? "mis"
+                                                                          : "mixture") +
                            "\"" + (s ? "" : " (the default)");
   if (const Json* r = find(o, "time_uniform_rate")) {
     if (m.sampling == DistanceSampling::Mfp)
       fail(at(mp, "time_uniform_rate"),
-           "only applies with \"distance_sampling\": \"time_uniform\" or \"mis\"" + uses, *r);
+           "only applies with \"distance_sampling\": \"time_uniform\", \"mis\" or \"mixture\"" +
+               uses,
+           *r);
     m.time_uniform_rate = not_tiny(number(*r, at(mp, "time_uniform_rate"), above(0)), kMinRate,
                                    at(mp, "time_uniform_rate"), *r);
   }

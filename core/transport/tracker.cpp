@@ -28,7 +28,7 @@ PathStats& PathStats::operator+=(const PathStats& o) {
 }
 
 MediumSample MediumTracker::sample(const Medium& med, const Ray& ray, double s_max, Rng& rng,
-                                   double u_main) const {
+                                   double u_main, double q_tu) const {
   MediumSample out;
   DistanceEvent& ev = out.main;
   if (!med.interacts()) {
@@ -39,7 +39,10 @@ MediumSample MediumTracker::sample(const Medium& med, const Ray& ray, double s_m
   const double u1 = u_main >= 0.0 ? u_main : rng.uniform();
   if (med.type == Medium::Type::Homogeneous) {
     const HomogeneousMedium& h = med.homogeneous;
-    if (med.strategy.kind == DistanceSampling::Mfp || !(h.sigma_s > 0)) {
+    // A mixture with no time-uniform share is mean-free-path sampling (mixture_pick keeps u).
+    const bool mfp = med.strategy.kind == DistanceSampling::Mfp ||
+                     (med.strategy.kind == DistanceSampling::Mixture && !(q_tu > 0));
+    if (mfp || !(h.sigma_s > 0)) {
       // Closed form; a purely absorbing medium is integrated exactly instead of sampled.
       const double s = h.sigma_s > 0 ? sample_exponential(h.sigma_t(), u1) : kInf;
       ev.collided = s < s_max;
@@ -51,16 +54,20 @@ MediumSample MediumTracker::sample(const Medium& med, const Ray& ray, double s_m
       return out;
     }
     ConstantSegments segments(h.sigma_t(), h.eta, s_max);
-    return finish(segments, med.strategy, u1, rng);
+    return finish(segments, med.strategy, u1, q_tu, rng);
   }
   GridMedium::Walker walker(*med.grid, ray, s_max);
-  return finish(walker, med.strategy, u1, rng);
+  return finish(walker, med.strategy, u1, q_tu, rng);
 }
 
 template <class Segments>
 MediumSample MediumTracker::finish(Segments& segments, const DistanceStrategy& st, double u1,
-                                   Rng& rng) const {
+                                   double q_tu, Rng& rng) const {
   MediumSample out;
+  if (st.kind == DistanceSampling::Mixture) {
+    out.main = sample_distance_mixture(segments, st, q_tu, u1);
+    return out;
+  }
   if (st.kind != DistanceSampling::Mis) {
     out.main = sample_distance(segments, st, u1);
     return out;

@@ -38,9 +38,11 @@ class MediumTracker {
   explicit MediumTracker(const Scene& scene) : scene_(scene) {}
 
   /// Next collision in `med` along `ray` before s_max (a surface, or infinity).
-  /// `u_main` >= 0 replaces the main distance draw (angular direction sampling draws it early).
-  MediumSample sample(const Medium& med, const Ray& ray, double s_max, Rng& rng,
-                      double u_main = -1) const;
+  /// `u_main` >= 0 replaces the main distance draw (angular direction sampling draws it early);
+  /// `q_tu` is the time-uniform share of a `mixture` medium (0: mean free path, as light paths
+  /// use).
+  MediumSample sample(const Medium& med, const Ray& ray, double s_max, Rng& rng, double u_main = -1,
+                      double q_tu = 0) const;
   /// Transmittance and time of flight of a straight connection x -> x + dist * w starting in
   /// medium m, passing through index-matched boundaries; false if a surface with a material
   /// blocks it.
@@ -55,7 +57,8 @@ class MediumTracker {
 
  private:
   template <class Segments>
-  MediumSample finish(Segments& segments, const DistanceStrategy& st, double u1, Rng& rng) const;
+  MediumSample finish(Segments& segments, const DistanceStrategy& st, double u1, double q_tu,
+                      Rng& rng) const;
 
   const Scene& scene_;
 };

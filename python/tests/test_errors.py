@@ -53,7 +53,7 @@ def test_load_scene_summarises():
 @pytest.mark.parametrize("keywords, pattern", [
     ({"spp": 0}, r"femto.render: spp: must be in \[1, 10000000\] \(got '0'\)"),
     ({"spp": "many"}, r"spp: expected an integer \(got 'many'\)"),
-    ({"distance_sampling": "fast"}, r"distance_sampling: expected mfp, time_uniform or mis"),
+    ({"distance_sampling": "fast"}, r"distance_sampling: expected mfp, time_uniform, mis or mixture"),
     ({"alpha": 0.5}, r"alpha: applies to the kernel film only"),
     ({"photon_radius": 1.0, "integrator": "path"}, r"photon_radius: applies to photon mapping"),
     ({"seed": -1}, r"seed: expected a non-negative integer"),
