@@ -35,6 +35,25 @@ struct Reciprocals {
   }
 };
 constexpr Reciprocals kRecip;
+
+// The series below for x < kSmallX as fixed polynomials: c[n][m] = (-1)^m / (m! (n + m + 1)),
+// m <= kSmallTerms - 1; the first term left out is below 1e-18 of the sum. Evaluated by Horner,
+// with no loop exit that depends on x (weighted absorption puts most bins here).
+constexpr double kSmallX = 0.05;
+constexpr int kSmallTerms = 9;
+struct SmallSeries {
+  double c[5][kSmallTerms];
+  constexpr SmallSeries() : c() {
+    for (int n = 0; n < 5; ++n) {
+      double f = 1;  // (-1)^m / m!
+      for (int m = 0; m < kSmallTerms; ++m) {
+        c[n][m] = f / (n + m + 1);
+        f = -f / (m + 1);
+      }
+    }
+  }
+};
+constexpr SmallSeries kSmall;
 }  // namespace
 
 void exp_moments(double k, double h, double J[5]) {
@@ -42,6 +61,15 @@ void exp_moments(double k, double h, double J[5]) {
   if (x == 0) {  // no absorption weighting: plain powers
     double hp = h;
     for (int n = 0; n < 5; ++n, hp *= h) J[n] = hp * kRecip.r[n + 1];
+    return;
+  }
+  if (x < kSmallX) {
+    double hp = h;
+    for (int n = 0; n < 5; ++n, hp *= h) {
+      double sn = kSmall.c[n][kSmallTerms - 1];
+      for (int m = kSmallTerms - 2; m >= 0; --m) sn = sn * x + kSmall.c[n][m];
+      J[n] = hp * sn;
+    }
     return;
   }
   if (x < 2.0) {  // J_n = h^(n+1) sum_m (-x)^m / (m! (n + m + 1)); no cancellation for x < 2
