@@ -21,7 +21,7 @@ namespace femto::diffusion {
 namespace {
 constexpr uint64_t kBatch = 4096;  // photons per batch: the unit of work and of ordered reduction
 
-// Traces photon `rng` is drawn for; step(p, rng, seg) moves p along one segment.
+// Traces one photon from its random stream; step(p, rng, seg) moves p along one segment.
 template <class Step>
 void trace_photon(const Step& step, double t_end, Rng rng, PhotonTally& tally, TallySums& sums) {
   Photon p;
