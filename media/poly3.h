@@ -34,8 +34,10 @@ struct Poly3 {
   }
   bool is_constant() const { return c[1] == 0 && c[2] == 0 && c[3] == 0; }
   double operator()(double t) const { return c[0] + t * (c[1] + t * (c[2] + t * c[3])); }
-  /// Integral from 0 to t.
+  /// Integral from 0 to t (t finite). Constant pieces (homogeneous media, nearest-neighbour
+  /// voxels) skip the division by 3 of the general form, which gives the same value for them.
   double integral(double t) const {
+    if (is_constant()) return t * c[0];
     return t * (c[0] + t * (c[1] / 2 + t * (c[2] / 3 + t * c[3] / 4)));
   }
 };
@@ -43,7 +45,11 @@ struct Poly3 {
 /// Smallest t in [0, t_max] with p.integral(t) = target, for p >= 0 on [0, t_max] and
 /// 0 <= target <= p.integral(t_max). Newton steps safeguarded by bisection.
 inline double invert_integral(const Poly3& p, double target, double t_max) {
-  if (p.is_constant()) return p.c[0] > 0 ? std::fmin(target / p.c[0], t_max) : t_max;
+  if (p.is_constant()) {
+    if (!(p.c[0] > 0)) return t_max;
+    const double t = target / p.c[0];
+    return t < t_max ? t : t_max;  // std::fmin is a library call; neither value is NaN here
+  }
   double lo = 0, hi = t_max;
   double t = 0.5 * (lo + hi);
   for (int it = 0; it < 100; ++it) {

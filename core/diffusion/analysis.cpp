@@ -177,7 +177,7 @@ TransitionConfidence transition_confidence(const DiffusionSetup& setup, const Di
   for (size_t b = 0; b < B; ++b) {
     TallySums rest;
     rest.reset(layout.size());
-    for (size_t i = 0; i < all.size(); ++i) rest.sum[i] = all[i] - r.batch_sum[b][i];
+    for (size_t i = 0; i < all.size(); ++i) rest.sum(i) = all[i] - r.batch_sum[b][i];
     rest.photons = r.photons - r.batch_photons[b];
     const DiffusionResult rb = estimate(setup, rest);
     const Transition tb = transition_time(axis, gaussian_distances(setup, rb), a.threshold);

@@ -21,13 +21,34 @@ namespace femto::diffusion {
 namespace {
 constexpr uint64_t kBatch = 4096;  // photons per batch: the unit of work and of ordered reduction
 
-void trace_photon(const PhotonTransport& transport, double t_end, Rng rng, PhotonTally& tally,
-                  TallySums& sums) {
+// Traces one photon from its random stream; step(p, rng, seg) moves p along one segment.
+template <class Step>
+void trace_photon(const Step& step, double t_end, Rng rng, PhotonTally& tally, TallySums& sums) {
   Photon p;
   const double u1 = rng.uniform(), u2 = rng.uniform();
   p.d = sample_uniform_sphere(u1, u2);
-  while (p.alive && p.t < t_end) tally.add(transport.advance(p, rng), sums);
+  Segment seg;
+  while (p.alive && p.t < t_end) {
+    step(p, rng, seg);
+    tally.add(seg, sums);
+  }
   tally.end_photon(sums);
+}
+
+// Photons [p0, p1) into sums, in order.
+void trace_photons(const PhotonTransport& transport, const DiffusionSetup& setup, uint64_t p0,
+                   uint64_t p1, PhotonTally& tally, TallySums& sums) {
+  const double t_end = setup.grid.time.t_end_ps();
+  // The homogeneous medium's walk inlined (no virtual call per segment); the same segments.
+  if (const auto* h = dynamic_cast<const InfiniteHomogeneous*>(&transport)) {
+    auto step = [h](Photon& p, Rng& rng, Segment& seg) { h->step(p, rng, seg); };
+    for (uint64_t i = p0; i < p1; ++i)
+      trace_photon(step, t_end, Rng::for_sample(setup.seed, i, 0), tally, sums);
+    return;
+  }
+  auto step = [&transport](Photon& p, Rng& rng, Segment& seg) { seg = transport.advance(p, rng); };
+  for (uint64_t i = p0; i < p1; ++i)
+    trace_photon(step, t_end, Rng::for_sample(setup.seed, i, 0), tally, sums);
 }
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -96,9 +117,7 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
         TallySums& sums = partial[k];
         sums.reset(layout.size());
         const uint64_t p0 = (u0 + k) * kBatch, p1 = std::min(N, p0 + kBatch);
-        for (uint64_t i = p0; i < p1; ++i)
-          trace_photon(transport, grid.time.t_end_ps(), Rng::for_sample(setup.seed, i, 0), tally,
-                       sums);
+        trace_photons(transport, setup, p0, p1, tally, sums);
         progress.add(p1 - p0);
       });
     });
@@ -107,7 +126,7 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
       total.add(part);
       const uint64_t b = unit * stat_batches / batches;
       std::vector<double>& bs = batch_sum[b];
-      for (size_t i = 0; i < bs.size(); ++i) bs[i] += part.sum[i];
+      for (size_t i = 0; i < bs.size(); ++i) bs[i] += part.sum(i);
       batch_photons[b] += part.photons;
     };
     if (comm.single()) {
@@ -116,8 +135,7 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
       distributed::ByteWriter mine;
       if (!comm.root())
         for (size_t k = 0; k < count; ++k) {
-          mine.put_vector(partial[k].sum);
-          mine.put_vector(partial[k].sum2);
+          mine.put_vector(partial[k].sums);
           mine.put(partial[k].photons);
           mine.put(partial[k].segments);
         }
@@ -131,8 +149,7 @@ DiffusionResult simulate(const DiffusionSetup& setup, const PhotonTransport& tra
         const uint64_t r1 = std::min(batches, r0 + slots);
         distributed::ByteReader in(bytes);
         for (uint64_t unit = r0; unit < r1; ++unit) {
-          theirs.sum = in.get_vector<double>();
-          theirs.sum2 = in.get_vector<double>();
+          theirs.sums = in.get_vector<double>();
           theirs.photons = in.get<uint64_t>();
           theirs.segments = in.get<uint64_t>();
           fold(unit, theirs);
@@ -173,8 +190,8 @@ DiffusionResult estimate(const DiffusionSetup& setup, const TallySums& total) {
   const double n = static_cast<double>(std::max<uint64_t>(total.photons, 1));
   // Mean and standard error of the per-photon integrals at index i, times scale.
   auto estimate = [&](size_t i, double scale, double& mean, double& err) {
-    const double m = total.sum[i] / n;
-    const double var = n > 1 ? std::max(0.0, (total.sum2[i] - n * m * m) / (n - 1)) : 0.0;
+    const double m = total.sum(i) / n;
+    const double var = n > 1 ? std::max(0.0, (total.sum2(i) - n * m * m) / (n - 1)) : 0.0;
     mean = m * scale;
     err = std::sqrt(var / n) * scale;
   };
@@ -187,8 +204,8 @@ DiffusionResult estimate(const DiffusionSetup& setup, const TallySums& total) {
   const double dt = grid.time.bin_width_ps;
   for (int j = 0; j < grid.time.bins; ++j) {
     for (int i = 0; i < grid.shells; ++i) {
-      const size_t c = layout.cell(i, j);
-      estimate(c, 1 / (grid.shell_volume(i) * dt), r.u[c], r.u_err[c]);
+      const size_t c = r.cell(i, j);
+      estimate(layout.cell(i, j), 1 / (grid.shell_volume(i) * dt), r.u[c], r.u_err[c]);
     }
     const double t0 = grid.time.bin_start_ps(j);
     estimate(layout.slot(Quantity::Energy, j), 1 / dt, r.energy[j], r.energy_err[j]);

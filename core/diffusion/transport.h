@@ -32,6 +32,8 @@ class InfiniteHomogeneous final : public PhotonTransport {
  public:
   InfiniteHomogeneous(const HomogeneousMedium& medium, Absorption absorption);
   Segment advance(Photon& p, Rng& rng) const override;
+  /// advance() without the virtual call and the copy: fills every field of seg in place.
+  void step(Photon& p, Rng& rng, Segment& seg) const { walk_step(space_, settings_, p, rng, seg); }
 
  private:
   UnboundedSpace space_;
