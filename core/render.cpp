@@ -231,6 +231,9 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
     m.integrator += beam_pass_bytes(
         (opt.integrator == IntegratorKind::Beams ? 8 : 2) *
         static_cast<uint64_t>(opt.photons.per_pass > 0 ? opt.photons.per_pass : 20000));
+  // The hybrid's light-traced indirect fog light: one path per pixel, about 4 splats each.
+  if (opt.integrator == IntegratorKind::Hybrid)
+    m.integrator += pixels * 4 * (sizeof(Splat) + sizeof(const Splat*)) + (pixels + 1) * 8;
   if (opt.integrator == IntegratorKind::Light) m.integrator = light_batch_bytes(pixels);
   // Writing: a frame, the peak-time image, the contact sheet's 16 frames and its 8-bit image,
   // the 8-bit preview; a multipart EXR is written from the film itself.

@@ -13,15 +13,20 @@
 #include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
 #include "core/integrators/ppm_schedule.h"
+#include "core/integrators/splat_deposit.h"
 #include "core/pixel_sampler.h"
 #include "core/progress.h"
 #include "core/render.h"
 #include "core/render_passes.h"
+#include "core/transport/chunked_paths.h"
 
 namespace femto {
 
 namespace {
 constexpr int kTile = 16;
+constexpr int64_t kIndirectChunk = 1024;  // indirect-light paths per task (deterministic order)
+/// Indirect-light streams are keyed apart from camera pixels, photons and beams.
+constexpr uint64_t kIndirectStream = 0x7000000000000000ULL;
 }
 
 RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
@@ -44,6 +49,11 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   PpmSchedule schedule(pd.radius, pd.bandwidth_ps, pd.alpha, pd.beta_t, use_photons ? 2 : 1);
   PpmSchedule beam_schedule(bd.radius, bd.bandwidth_ps, bd.alpha, bd.beta_t, 1);
   const MediumTracker tracker(scene);
+  // Hybrid: light paths splatted from their medium vertices once they have scattered (off a
+  // diffuse surface or in a medium), which camera paths then leave out: one light path per pixel
+  // per pass (docs/ARCHITECTURE.md, "Path-space partition").
+  const bool light_indirect = caustic_beams;
+  const int64_t indirect_paths = static_cast<int64_t>(W) * H;
   // Photon times include the emission offset: the window end plus the widest pulse spread.
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
 
@@ -71,6 +81,10 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   tbb::enumerable_thread_specific<PathStats> stats;
   PhotonGrid grid;
   BeamBvh bvh;
+  const LightTracer indirect_tracer(scene, opt.max_depth, photon_t_cut,
+                                    LightTracer::Vertices::MediumIndirect);
+  std::vector<uint32_t> splat_offsets;
+  std::vector<const Splat*> splat_order;
   tbb::task_arena arena(threads);
   arena.execute([&] {
     while (state.units_done < opt.spp) {
@@ -102,6 +116,26 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
         grid.build(std::move(photons), schedule.radius());
         pass_bytes += grid.memory_bytes();
       }
+      if (light_indirect) {
+        const std::vector<Splat> splats = trace_in_chunks<Splat>(
+            indirect_paths, kIndirectChunk, photon_stats,
+            [&](int64_t i, std::vector<Splat>& out, PathStats& st) {
+              Rng rng = Rng::for_sample(opt.seed, kIndirectStream + static_cast<uint64_t>(pass),
+                                        static_cast<uint64_t>(i));
+              indirect_tracer.trace(rng, out, st);
+            },
+            opt.comm);
+        // Each rank keeps the splats of its own bands of tile rows (gathered at the end).
+        deposit_splats(
+            splats, 1.0 / static_cast<double>(indirect_paths), filter, pixels, stride, nb,
+            state.sums.data(),
+            [&](size_t p) {
+              return comm.owns(static_cast<int64_t>(p / static_cast<size_t>(W)) / kTile);
+            },
+            splat_offsets, splat_order);
+        pass_bytes += splats.size() * (sizeof(Splat) + sizeof(const Splat*)) +
+                      (pixels + 1) * sizeof(uint32_t) * 2;
+      }
       state.photon_peak_bytes = std::max(state.photon_peak_bytes, pass_bytes);
       PhotonGather gather;
       gather.grid = &grid;
@@ -131,7 +165,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                   const double fx = x + dx, fy = y + dy;
                   integrator.trace(camera.generate_ray(fx, fy), rng, acc, st,
                                    use_photons ? &gather : nullptr,
-                                   use_beams ? &beam_gather : nullptr);
+                                   use_beams ? &beam_gather : nullptr, light_indirect);
                   double* dst = state.sums.data() + p * stride;
                   for (size_t i = 0; i < nb; ++i) dst[i] += acc.bins[i];
                   passes::store_rgb(dst + nb, passes::load_rgb(dst + nb) + acc.before);

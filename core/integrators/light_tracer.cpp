@@ -6,12 +6,13 @@
 
 namespace femto {
 
-LightTracer::LightTracer(const Scene& scene, int max_depth, double t_cut_ps)
+LightTracer::LightTracer(const Scene& scene, int max_depth, double t_cut_ps, Vertices vertices)
     : scene_(scene),
       tracker_(scene),
       max_depth_(max_depth),
       t_cut_(t_cut_ps),
-      unwarp_(scene.desc().time_mode == TimeMode::Unwarp) {}
+      unwarp_(scene.desc().time_mode == TimeMode::Unwarp),
+      vertices_(vertices) {}
 
 void LightTracer::splat(const Vec3& x, int m, const Vec3& w, double dist, const RGB& value,
                         double t_ps, double sigma_ps, double fx, double fy, std::vector<Splat>& out,
@@ -34,7 +35,21 @@ void LightTracer::splat(const Vec3& x, int m, const Vec3& w, double dist, const 
 void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) const {
   const Camera& cam = scene_.camera();
   const double eps = scene_.ray_epsilon();
+  const bool indirect_only = vertices_ == Vertices::MediumIndirect;
+  bool scattered = false;  // a diffuse surface or medium vertex so far
   walk_light_path(scene_, tracker_, rng, max_depth_, t_cut_, stats, [&](const LightVertex& v) {
+    if (indirect_only) {
+      if (v.kind == LightVertex::Kind::Surface) {
+        scattered = scattered || v.bsdf->is_diffuse();
+        return true;
+      }
+      if (v.kind != LightVertex::Kind::Medium) return true;
+      const bool after_scattering = scattered;
+      if (!v.connection_only) scattered = true;
+      // Direct light (light -> M) and caustics (light -> (S|G)+ -> M) are the camera paths' and
+      // the beams' share.
+      if (!after_scattering) return true;
+    }
     double fx, fy, dist, W;
     Vec3 w;
     if (!cam.connect_to(v.p, fx, fy, w, dist, W)) return true;

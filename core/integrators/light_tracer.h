@@ -22,7 +22,13 @@ struct Splat {
 
 class LightTracer {
  public:
-  LightTracer(const Scene& scene, int max_depth, double t_cut_ps);
+  /// Which vertices are splatted. MediumIndirect: only medium vertices whose light sub-path has
+  /// scattered before (off a diffuse surface or in a medium): light -> X* (D|M) X* -> M ->
+  /// sensor; the hybrid integrator's camera paths leave exactly those paths out
+  /// (docs/ARCHITECTURE.md, "Path-space partition").
+  enum class Vertices { All, MediumIndirect };
+  LightTracer(const Scene& scene, int max_depth, double t_cut_ps,
+              Vertices vertices = Vertices::All);
   /// Traces one light path and appends its sensor splats to `out`.
   void trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) const;
 
@@ -38,6 +44,7 @@ class LightTracer {
   int max_depth_;
   double t_cut_;
   bool unwarp_;
+  Vertices vertices_;
 };
 
 }  // namespace femto

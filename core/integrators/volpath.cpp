@@ -137,7 +137,8 @@ void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceH
 }
 
 void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats,
-                              const PhotonGather* photons, const BeamGather* beams) const {
+                              const PhotonGather* photons, const BeamGather* beams,
+                              bool light_indirect) const {
   const auto& media = scene_.media();
   const auto& shapes = scene_.desc().shapes;
   const LightSet& lights = scene_.lights();
@@ -166,13 +167,17 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   };
   // All beams: they own the paths whose first non-specular vertex from the camera is in a medium.
   bool beam_prefix = beams != nullptr && !caustic_beams;
+  // Light tracing owns light -> X* (D|M) X* -> x_c -> camera, x_c the path's first vertex when it
+  // is a medium vertex: past x_c the path only looks for an emitter hit (the other half of x_c's
+  // next-event MIS) and ends at its next vertex.
+  bool past_xc = false;
 
   for (;;) {
     SurfaceHit hit;
     const bool found = scene_.geometry().intersect(ray, 0.0, kInf, hit);
     const double s_surf = found ? hit.s : kInf;
     const Medium& med = media[static_cast<size_t>(m)];
-    if (caustic_beams && med.interacts() && depth < max_depth_)
+    if (caustic_beams && med.interacts() && depth < max_depth_ && !past_xc)
       beams->gather(m, ray, s_surf, beta, t,
                     unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
     if (beam_prefix && med.interacts()) {
@@ -193,7 +198,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next, q_tu);
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
       const ConnectedSegment segment = plan_segment(med, ray, s_surf);
-      if (segment.active && depth < max_depth_)
+      if (segment.active && depth < max_depth_ && !past_xc)
         estimate_segment(med, m, segment, beta, t, t_dropped, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every
       // strategy's MIS weight at this segment's vertices sees the same r_aux.
@@ -204,7 +209,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const DirectionMix mix_main =
           angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next, depth + 1)
                   : DirectionMix{};
-      if (ms.extra.collided && depth < max_depth_) {
+      if (ms.extra.collided && depth < max_depth_ && !past_xc) {
         // The time-uniform collision of MIS: next-event estimation only (the path goes on from
         // the mean-free-path collision).
         const Vec3 x2 = ray.at(ms.extra.s);
@@ -223,6 +228,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
 
       if (ev.collided) {
         // Real collision: absorb by weighting with the single-scattering albedo.
+        if (past_xc) break;
+        past_xc = light_indirect && on_camera_segment;
         on_camera_segment = false;
         last = Last::Medium;
         since = 0;
@@ -268,6 +275,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       ray.o = hit.p + ray.d * eps;
       continue;
     }
+    if (past_xc) break;
     on_camera_segment = false;
     ++stats.surface_events;
     if (depth >= max_depth_) {

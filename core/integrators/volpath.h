@@ -29,9 +29,13 @@ class VolPathIntegrator {
   /// contributions to `acc`. With `photons`, caustic paths (light -> non-diffuse surfaces ->
   /// diffuse surface) come from the photons gathered at diffuse vertices, not from this path.
   /// With `beams`, light scattered in a medium before the path's first non-specular surface
-  /// comes from photon beams gathered along those segments.
+  /// comes from photon beams gathered along those segments. With `light_indirect`, when the
+  /// path's first vertex is a medium vertex x_c, only light arriving there directly (next-event
+  /// estimation, emission hit, caustic beams) comes from this path: light that scattered before
+  /// reaching x_c comes from light tracing (LightTracer::Vertices::MediumIndirect).
   void trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats,
-             const PhotonGather* photons = nullptr, const BeamGather* beams = nullptr) const;
+             const PhotonGather* photons = nullptr, const BeamGather* beams = nullptr,
+             bool light_indirect = false) const;
 
   /// Path time beyond which no contribution can reach the window, ps.
   double time_cutoff_ps() const { return t_cut_; }
