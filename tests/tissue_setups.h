@@ -1,6 +1,8 @@
 #pragma once
 // Small tissue-optics setups built in code for the tests.
-#include "core/tissue/setup.h"
+#include <catch2/catch.hpp>
+
+#include "core/tissue/simulate.h"
 
 namespace femto::test {
 
@@ -23,6 +25,24 @@ inline tissue::Setup tissue_box(int nx, int ny, int nz, double voxel, const Tiss
   s.source.direction = {0, 0, 1};
   s.threads = 2;
   return s;
+}
+
+/// Checks that two runs gave bit-identical volume, detector and balance outputs (not the per-label
+/// tallies, which may differ in width).
+inline void check_same_outputs(const tissue::Result& a, const tissue::Result& b) {
+  CHECK(a.scatterings == b.scatterings);
+  CHECK(a.segments == b.segments);
+  CHECK(a.fluence == b.fluence);
+  CHECK(a.fluence_err == b.fluence_err);
+  CHECK(a.tpsf == b.tpsf);
+  CHECK(a.face_exitance == b.face_exitance);
+  CHECK(a.detected.weight == b.detected.weight);
+  CHECK(a.detected.time_ps == b.detected.time_ps);
+  CHECK(a.detected.exit == b.detected.exit);
+  CHECK(a.balance.absorbed == b.balance.absorbed);
+  CHECK(a.balance.escaped_faces == b.balance.escaped_faces);
+  CHECK(a.balance.specular == b.balance.specular);
+  CHECK(a.balance.alive == b.balance.alive);
 }
 
 }  // namespace femto::test
