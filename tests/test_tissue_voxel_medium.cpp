@@ -190,3 +190,29 @@ TEST_CASE("femto render refuses bad voxel-medium tissue scenes", "[tissue][cli]"
   CHECK(run.code == 0);
   CHECK(fs::exists(tmp.dir / "out" / "summary.json"));
 }
+
+// Catches `femto info` refusing tissue scenes or describing them wrongly (labels, voxel media),
+// and bad tissue scenes that it accepts.
+TEST_CASE("femto info summarises tissue scenes", "[tissue][cli]") {
+  const fs::path scenes = fs::path(FEMTO_SOURCE_DIR) / "data" / "scenes";
+  const auto cube = test::run_femto({"info", (scenes / "cube60.json").string()}, scenes);
+  INFO(cube.err);
+  CHECK(cube.code == 0);
+  CHECK(cube.out.find("volume: 60 x 60 x 60 voxels of 1 mm") != std::string::npos);
+  CHECK(cube.out.find("label 1: mu_a 0.005 /mm, mu_s 1 /mm, g 0.01, n 1.37; 216000 voxels") !=
+        std::string::npos);
+  CHECK(cube.out.find("time: 50 gates of 100 ps") != std::string::npos);
+  const auto vdb = test::run_femto({"info", (scenes / "tissue_vdb.json").string()}, scenes);
+  INFO(vdb.err);
+  CHECK(vdb.code == 0);
+  CHECK(vdb.out.find("medium: optics per voxel") != std::string::npos);
+  CHECK(vdb.out.find("n 1.37 to 1.45, g 0.8") != std::string::npos);
+  test::TempDir tmp("femto_tissue_info_bad");
+  std::string text = test::read_file(scenes / "cube60.json");
+  const std::string g = R"("g": 0.01)";
+  text.replace(text.find(g), g.size(), R"("g": 1.5)");
+  test::write_file(tmp.dir / "bad.json", text);
+  const auto bad = test::run_femto({"info", "bad.json"}, tmp.dir);
+  CHECK(bad.code == 2);
+  CHECK(bad.err.find("bad.json: /tissue/labels/0/g: must be in (-1, 1)") != std::string::npos);
+}
