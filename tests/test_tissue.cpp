@@ -91,6 +91,31 @@ TEST_CASE("tissue outputs are bit-identical for any thread count", "[tissue]") {
   REQUIRE(a.detected.size() > 10);
 }
 
+// Catches detected-photon records out of photon order (a chunk's photons walk gate by gate, so
+// they are detected gate by gate): the records of the first photons of a run are the first
+// records of a longer run with the same seed, in the same order.
+TEST_CASE("detected-photon records come in photon order", "[tissue]") {
+  Setup s = tissue_box(20, 20, 20, 1.0, TissueOptics{0.01, 1.0, 0.5, 1.4});
+  s.time = TimeAxis{0, 20, 12};
+  s.detectors = {{{10, 10, 0}, 8.0, 0.0}};
+  s.fluence = false;
+  s.batches = 1;
+  s.photons = 1000;  // one chunk
+  const Result all = simulate(s);
+  s.photons = 500;
+  const Result first = simulate(s);
+  REQUIRE(first.detected.size() > 50);
+  REQUIRE(all.detected.size() > first.detected.size());
+  const size_t n = first.detected.size();
+  for (size_t i = 0; i < n; ++i) {
+    INFO("record " << i);
+    CHECK(first.detected.time_ps[i] == all.detected.time_ps[i]);
+    CHECK(first.detected.weight[i] == all.detected.weight[i]);
+    CHECK(first.detected.ppath[i] == all.detected.ppath[i]);
+    CHECK(first.detected.exit[6 * i] == all.detected.exit[6 * i]);
+  }
+}
+
 // Catches errors in the track-length estimator: the weight integral exp(-mu_a s) per voxel,
 // the splitting of a segment at gate boundaries, the fluence normalisation (1/mm^2 per unit
 // energy) and the speed c / n. Unscattered pencil beam, so every photon follows the same line.

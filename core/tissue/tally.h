@@ -48,22 +48,29 @@ class Tally {
         scale_(scale),
         gates_(s.time.bins),
         same_grid_(s.fluence && same_grid(s)),
-        ppath_(s.volume.optics.size(), 0.0) {
+        labels_(s.volume.optics.size()) {
     const FluenceGrid& fg = s.fluence_grid;
     h_ = fg.spacing();
     cells_ = layout_.slots;
     plane_tolerance_ = 1e-6 * s.volume.voxel;
   }
-  void begin(ChunkSums& out) {
+  /// A chunk of `photons` photons starts: their partial paths are 0 and no record is kept.
+  void start_chunk(ChunkSums& out, size_t photons) {
     out_ = &out;
-    std::fill(ppath_.begin(), ppath_.end(), 0.0);
+    ppaths_.assign(s_.detectors.empty() ? 0 : photons * labels_, 0.0);
+    record_photon_.clear();
+  }
+  /// Photon `slot` of the chunk walks on (a chunk's photons walk gate by gate, in turns).
+  void begin(size_t slot) {
+    slot_ = slot;
+    ppath_ = ppaths_.empty() ? nullptr : ppaths_.data() + slot * labels_;
   }
 
   void segment(const Segment& seg) {
     ++out_->segments;
     out_->absorbed[static_cast<size_t>(seg.label)] += seg.absorbed;
     out_->balance.absorbed += seg.absorbed;
-    if (!s_.detectors.empty()) ppath_[static_cast<size_t>(seg.label)] += seg.length();
+    if (ppath_) ppath_[static_cast<size_t>(seg.label)] += seg.length();
     if (s_.fluence && seg.duration > 0) fluence(seg);
   }
 
@@ -85,6 +92,8 @@ class Tally {
 
   void alive(const Photon& p) { out_->balance.alive += p.w; }
   void end() { flush(); }
+  /// The chunk's detected-photon records in photon order (they were made gate by gate).
+  void end_chunk() { sort_records(out_->records, record_photon_); }
 
  private:
   static bool same_grid(const Setup& s) {
@@ -260,7 +269,8 @@ class Tally {
       rec.scatterings.push_back(p.scatterings);
       rec.weight.push_back(p.w);
       rec.time_ps.push_back(p.t);
-      rec.ppath.insert(rec.ppath.end(), ppath_.begin() + 1, ppath_.end());
+      record_photon_.push_back(static_cast<uint32_t>(slot_));
+      rec.ppath.insert(rec.ppath.end(), ppath_ + 1, ppath_ + labels_);
       rec.exit.insert(rec.exit.end(), {p.x.x, p.x.y, p.x.z, p.d.x, p.d.y, p.d.z});
       return;  // a photon counts for the first detector it reaches
     }
@@ -278,7 +288,11 @@ class Tally {
   static constexpr size_t kNone = ~size_t{0};
   size_t pending_ = kNone;
   double pending_value_ = 0;
-  std::vector<double> ppath_;  // per label, this photon
+  size_t labels_;
+  std::vector<double> ppaths_;  // (photon of the chunk, label): partial path lengths
+  double* ppath_ = nullptr;     // this photon's row
+  size_t slot_ = 0;             // this photon's place in the chunk
+  std::vector<uint32_t> record_photon_;  // per record: its photon's place in the chunk
   ChunkSums* out_ = nullptr;
 };
 
