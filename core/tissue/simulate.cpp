@@ -63,6 +63,7 @@ bool walk_until(const Space& space, const WalkSettings& stop, bool last, Photon&
     return false;
   }
   Segment seg;
+  seg.crossings = tally.crossings();
   while (true) {
     const StepEvent ev = walk_step(space, stop, p, rng, seg);
     tally.segment(seg);
@@ -86,8 +87,8 @@ bool walk_until(const Space& space, const WalkSettings& stop, bool last, Photon&
 // of gate j before any goes on into gate j + 1, so the fluence deposits fall into one gate's grid
 // at a time (it stays in cache). Photon i always draws from Rng::for_sample(seed, i, 0).
 template <class Space, class Tally>
-void trace_chunk(const Setup& s, const Space& space, const Emitter& emitter,
-                 const WalkSettings& ws, uint64_t q0, uint64_t q1, Tally& tally, ChunkSums& out) {
+void trace_chunk(const Setup& s, const Space& space, const Emitter& emitter, const WalkSettings& ws,
+                 uint64_t q0, uint64_t q1, Tally& tally, ChunkSums& out) {
   std::vector<Walker> walkers;
   walkers.reserve(static_cast<size_t>(q1 - q0));
   for (uint64_t i = q0; i < q1; ++i) {
