@@ -3,6 +3,7 @@
 // mu_a, NIfTI-1 and OpenVDB label volumes, and the command line.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include "core/tissue/pulse.h"
 #include "core/tissue/scene.h"
 #include "core/tissue/simulate.h"
+#include "core/transport/tissue_walk.h"
 #include "media/label_grid_vdb.h"
 #include "run_femto.h"
 #include "temp_dir.h"
@@ -622,4 +624,15 @@ TEST_CASE("a spot source emits in its cone with unit mean weight", "[tissue]") {
   INFO("mean launch weight " << f.balance.launched / N);
   CHECK(std::abs(f.balance.launched / N - 1) <= 4 * std::sqrt(w_max / N));
   CHECK(std::abs(f.balance.residual()) <= 1e-12 * f.balance.launched);
+}
+
+// Catches a wrong or too short series in the walk's absorbed fraction 1 - exp(-mu_a s) (the
+// energy balance alone would not: absorbed + carried is w0 by construction whatever its value).
+TEST_CASE("the walk's 1 - exp(-x) is accurate to 1e-13 on both sides of its series", "[tissue]") {
+  double worst = 0;
+  for (double x = 1e-12; x < 2; x *= 1.001) {
+    const double exact = -std::expm1(-x);
+    worst = std::max(worst, std::abs(one_minus_exp(x) - exact) / exact);
+  }
+  CHECK(worst < 1e-13);
 }
