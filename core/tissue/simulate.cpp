@@ -304,7 +304,9 @@ Result simulate(const Setup& s) {
       all.tpsf[i] += batch_tpsf[i];
       r.tpsf_batches[static_cast<size_t>(b) * tpsf_size + i] = batch_tpsf[i];
     }
-    // Integer sums of the threads: exact, so their order does not matter.
+    // Integer sums of the threads: exact, so their order does not matter. Without standard
+    // errors the threads keep adding theirs until the last batch (the scale allows all photons).
+    if (!s.fluence_stderr && b + 1 < batches) continue;
     const double batch_n = static_cast<double>(p1 - p0);
     for (ThreadSums& ts : thread_sums) {
       for (size_t i = 0; i < volume_size; ++i) total.fluence[i] += ts.fluence[i];
