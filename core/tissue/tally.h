@@ -185,6 +185,15 @@ class Tally {
       const VoxelCrossings* vc = seg.crossings;
       if (vc && vc->complete()) {  // the faces the walk's march crossed: no second march
         const int step[3] = {seg.d[0] > 0 ? 1 : -1, seg.d[1] > 0 ? 1 : -1, seg.d[2] > 0 ? 1 : -1};
+        if (one_gate) {  // the sums are likely cache misses: ask for all of them at once
+          int c[3] = {cx, cy, cz};
+          const uint64_t* sums = sums_.fluence.data() + gate_offset;
+          __builtin_prefetch(sums + layout_.index(c[0], c[1], c[2]), 1);
+          for (int q = 0; q < vc->count; ++q) {
+            c[vc->axis[q]] += step[vc->axis[q]];
+            __builtin_prefetch(sums + layout_.index(c[0], c[1], c[2]), 1);
+          }
+        }
         for (int q = 0; q < vc->count; ++q) {
           piece(cx, cy, cz, vc->s[q]);
           const int a = vc->axis[q];
