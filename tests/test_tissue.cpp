@@ -100,7 +100,7 @@ TEST_CASE("detected-photon records come in photon order", "[tissue]") {
   Setup s = tissue_box(20, 20, 20, 1.0, TissueOptics{0.01, 1.0, 0.5, 1.4});
   s.time = TimeAxis{0, 20, 12};
   s.detectors = {{{10, 10, 0}, 8.0, 0.0}};
-  s.fluence = false;
+  s.fluence = true;  // with a fluence volume, a chunk's photons walk gate by gate
   s.batches = 1;
   s.photons = 1000;  // one chunk
   const Result all = simulate(s);

@@ -104,9 +104,10 @@ void trace_chunk(const Setup& s, const Space& space, const Emitter& emitter, con
     walkers.push_back(w);
   }
   tally.start_chunk(out, static_cast<size_t>(q1 - q0));
-  const int gates = s.time.bins;
-  for (int j = 0; j < gates && !walkers.empty(); ++j) {
-    const bool last = j + 1 == gates;
+  // Without a fluence volume, nothing gains from the gates' stops: one turn to the window end.
+  const int turns = s.fluence ? s.time.bins : 1;
+  for (int j = 0; j < turns && !walkers.empty(); ++j) {
+    const bool last = j + 1 == turns;
     WalkSettings stop = ws;
     if (!last) stop.t_end = s.time.bin_start_ps(j + 1);
     size_t kept = 0;
