@@ -3,6 +3,7 @@
 // mu_a, NIfTI-1 and OpenVDB label volumes, and the command line.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include "core/tissue/pulse.h"
 #include "core/tissue/scene.h"
 #include "core/tissue/simulate.h"
+#include "core/transport/tissue_walk.h"
 #include "media/label_grid_vdb.h"
 #include "run_femto.h"
 #include "temp_dir.h"
@@ -89,6 +91,31 @@ TEST_CASE("tissue outputs are bit-identical for any thread count", "[tissue]") {
   femto::test::check_same_outputs(a, b);
   CHECK(a.detected.ppath == b.detected.ppath);
   REQUIRE(a.detected.size() > 10);
+}
+
+// Catches detected-photon records out of photon order (a chunk's photons walk gate by gate, so
+// they are detected gate by gate): the records of the first photons of a run are the first
+// records of a longer run with the same seed, in the same order.
+TEST_CASE("detected-photon records come in photon order", "[tissue]") {
+  Setup s = tissue_box(20, 20, 20, 1.0, TissueOptics{0.01, 1.0, 0.5, 1.4});
+  s.time = TimeAxis{0, 20, 12};
+  s.detectors = {{{10, 10, 0}, 8.0, 0.0}};
+  s.fluence = true;  // with a fluence volume, a chunk's photons walk gate by gate
+  s.batches = 1;
+  s.photons = 1000;  // one chunk
+  const Result all = simulate(s);
+  s.photons = 500;
+  const Result first = simulate(s);
+  REQUIRE(first.detected.size() > 50);
+  REQUIRE(all.detected.size() > first.detected.size());
+  const size_t n = first.detected.size();
+  for (size_t i = 0; i < n; ++i) {
+    INFO("record " << i);
+    CHECK(first.detected.time_ps[i] == all.detected.time_ps[i]);
+    CHECK(first.detected.weight[i] == all.detected.weight[i]);
+    CHECK(first.detected.ppath[i] == all.detected.ppath[i]);
+    CHECK(first.detected.exit[6 * i] == all.detected.exit[6 * i]);
+  }
 }
 
 // Catches errors in the track-length estimator: the weight integral exp(-mu_a s) per voxel,
@@ -597,4 +624,15 @@ TEST_CASE("a spot source emits in its cone with unit mean weight", "[tissue]") {
   INFO("mean launch weight " << f.balance.launched / N);
   CHECK(std::abs(f.balance.launched / N - 1) <= 4 * std::sqrt(w_max / N));
   CHECK(std::abs(f.balance.residual()) <= 1e-12 * f.balance.launched);
+}
+
+// Catches a wrong or too short series in the walk's absorbed fraction 1 - exp(-mu_a s) (the
+// energy balance alone would not: absorbed + carried is w0 by construction whatever its value).
+TEST_CASE("the walk's 1 - exp(-x) is accurate to 1e-13 on both sides of its series", "[tissue]") {
+  double worst = 0;
+  for (double x = 1e-12; x < 2; x *= 1.001) {
+    const double exact = -std::expm1(-x);
+    worst = std::max(worst, std::abs(one_minus_exp(x) - exact) / exact);
+  }
+  CHECK(worst < 1e-13);
 }

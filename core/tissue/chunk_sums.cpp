@@ -1,6 +1,30 @@
 #include "core/tissue/chunk_sums.h"
 
+#include <algorithm>
+#include <numeric>
+
 namespace femto::tissue {
+
+void sort_records(DetectedPhotons& r, const std::vector<uint32_t>& key) {
+  const size_t n = r.size();
+  if (n == 0 || std::is_sorted(key.begin(), key.end())) return;
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key[a] < key[b]; });
+  auto permute = [&](auto& v, size_t width) {
+    auto out = v;
+    for (size_t i = 0; i < n; ++i)
+      std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(order[i] * width), width,
+                  out.begin() + static_cast<std::ptrdiff_t>(i * width));
+    v.swap(out);
+  };
+  permute(r.detector, 1);
+  permute(r.scatterings, 1);
+  permute(r.weight, 1);
+  permute(r.time_ps, 1);
+  permute(r.ppath, r.ppath.size() / n);  // labels 1.. per record
+  permute(r.exit, 6);
+}
 
 void write_chunk(distributed::ByteWriter& w, const ChunkSums& c) {
   w.put(c.balance);

@@ -29,6 +29,9 @@ struct ChunkSums {
   }
 };
 
+/// Puts the records in increasing order of `key` (one distinct key per record).
+void sort_records(DetectedPhotons& r, const std::vector<uint32_t>& key);
+
 /// A chunk's sums as bytes, bit for bit (for rank 0, core/distributed/comm.h), and back.
 void write_chunk(distributed::ByteWriter& w, const ChunkSums& c);
 void read_chunk(distributed::ByteReader& in, ChunkSums& c);

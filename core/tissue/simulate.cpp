@@ -45,35 +45,81 @@ int fixed_point_bits(const Setup& s, double max_weight) {
   return std::clamp(static_cast<int>(std::floor(std::log2(headroom))), 0, 40);
 }
 
-template <class Space, class Tally>
-void trace_photon(const Setup& s, const Space& space, const Emitter& emitter,
-                  const WalkSettings& ws, Rng rng, Tally& tally, ChunkSums& out) {
+// A photon of a chunk between its turns (the chunk walks gate by gate).
+struct Walker {
   Photon p;
-  double specular = 0;
-  const bool entered = launch(s, space, emitter, rng, p, specular);
-  out.balance.launched += p.w + specular;  // 1, or a spot light's falloff weight (mean 1)
-  if (!entered) {
-    out.balance.missed += p.w;
-    return;
-  }
-  out.balance.specular += specular;
-  tally.begin(out);
-  if (p.t >= ws.t_end) {  // emitted after the window
+  Rng rng;
+  uint32_t slot;  // place in the chunk
+};
+
+// Walks p until it dies or reaches `stop` (ws.t_end: the end of the current gate); true if it
+// walks on in the next gate. `last`: stop is the window end.
+template <class Space, class Tally>
+bool walk_until(const Space& space, const WalkSettings& stop, bool last, Photon& p, Rng& rng,
+                Tally& tally, ChunkSums& out) {
+  if (p.t >= stop.t_end) {  // emitted after this gate
+    if (!last) return true;
     tally.alive(p);
-    tally.end();
-    return;
+    return false;
   }
   Segment seg;
+  seg.crossings = tally.crossings();
   while (true) {
-    const StepEvent ev = walk_step(space, ws, p, rng, seg);
+    const StepEvent ev = walk_step(space, stop, p, rng, seg);
     tally.segment(seg);
     if (ev == StepEvent::Scattered) continue;
     if (ev == StepEvent::Escaped) tally.escape(p);
-    if (ev == StepEvent::WindowEnd) tally.alive(p);
+    if (ev == StepEvent::WindowEnd) {
+      if (!last) {  // a gate's end: the optical depth to the next scattering carries on
+        p.alive = true;
+        p.tau_left = std::max(0.0, p.tau_left);
+        return true;
+      }
+      tally.alive(p);
+    }
     if (!p.alive) break;
   }
-  tally.end();
   out.scatterings += static_cast<uint64_t>(p.scatterings);
+  return false;
+}
+
+// Photons q0 .. q1 - 1, launched, then walked gate by gate: every photon of the chunk to the end
+// of gate j before any goes on into gate j + 1, so the fluence deposits fall into one gate's grid
+// at a time (it stays in cache). Photon i always draws from Rng::for_sample(seed, i, 0).
+template <class Space, class Tally>
+void trace_chunk(const Setup& s, const Space& space, const Emitter& emitter, const WalkSettings& ws,
+                 uint64_t q0, uint64_t q1, Tally& tally, ChunkSums& out) {
+  std::vector<Walker> walkers;
+  walkers.reserve(static_cast<size_t>(q1 - q0));
+  for (uint64_t i = q0; i < q1; ++i) {
+    Walker w{Photon{}, Rng::for_sample(s.seed, i, 0), static_cast<uint32_t>(i - q0)};
+    double specular = 0;
+    const bool entered = launch(s, space, emitter, w.rng, w.p, specular);
+    out.balance.launched += w.p.w + specular;  // 1, or a spot light's falloff weight (mean 1)
+    if (!entered) {
+      out.balance.missed += w.p.w;
+      continue;
+    }
+    out.balance.specular += specular;
+    walkers.push_back(w);
+  }
+  tally.start_chunk(out, static_cast<size_t>(q1 - q0));
+  // Without a fluence volume, nothing gains from the gates' stops: one turn to the window end.
+  const int turns = s.fluence ? s.time.bins : 1;
+  for (int j = 0; j < turns && !walkers.empty(); ++j) {
+    const bool last = j + 1 == turns;
+    WalkSettings stop = ws;
+    if (!last) stop.t_end = s.time.bin_start_ps(j + 1);
+    size_t kept = 0;
+    for (Walker& w : walkers) {
+      tally.begin(w.slot);
+      const bool on = walk_until(space, stop, last, w.p, w.rng, tally, out);
+      tally.end();
+      if (on) walkers[kept++] = w;
+    }
+    walkers.resize(kept);
+  }
+  tally.end_chunk();
 }
 }  // namespace
 
@@ -177,13 +223,10 @@ Result simulate(const Setup& s) {
         out.reset(labels, tpsf_size, ndet);
         Tally tally(s, ts, scale);
         const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
-        for (uint64_t i = q0; i < q1; ++i) {
-          const Rng rng = Rng::for_sample(s.seed, i, 0);
-          if (voxel_space)
-            trace_photon(s, *voxel_space, emitter, ws, rng, tally, out);
-          else
-            trace_photon(s, space, emitter, ws, rng, tally, out);
-        }
+        if (voxel_space)
+          trace_chunk(s, *voxel_space, emitter, ws, q0, q1, tally, out);
+        else
+          trace_chunk(s, space, emitter, ws, q0, q1, tally, out);
         progress.add(q1 - q0);
         if (s.photons_done) s.photons_done->fetch_add(q1 - q0);
       });
@@ -262,7 +305,9 @@ Result simulate(const Setup& s) {
       all.tpsf[i] += batch_tpsf[i];
       r.tpsf_batches[static_cast<size_t>(b) * tpsf_size + i] = batch_tpsf[i];
     }
-    // Integer sums of the threads: exact, so their order does not matter.
+    // Integer sums of the threads: exact, so their order does not matter. Without standard
+    // errors the threads keep adding theirs until the last batch (the scale allows all photons).
+    if (!s.fluence_stderr && b + 1 < batches) continue;
     const double batch_n = static_cast<double>(p1 - p0);
     for (ThreadSums& ts : thread_sums) {
       for (size_t i = 0; i < volume_size; ++i) total.fluence[i] += ts.fluence[i];

@@ -48,22 +48,29 @@ class Tally {
         scale_(scale),
         gates_(s.time.bins),
         same_grid_(s.fluence && same_grid(s)),
-        ppath_(s.volume.optics.size(), 0.0) {
+        labels_(s.volume.optics.size()) {
     const FluenceGrid& fg = s.fluence_grid;
     h_ = fg.spacing();
     cells_ = layout_.slots;
     plane_tolerance_ = 1e-6 * s.volume.voxel;
   }
-  void begin(ChunkSums& out) {
+  /// A chunk of `photons` photons starts: their partial paths are 0 and no record is kept.
+  void start_chunk(ChunkSums& out, size_t photons) {
     out_ = &out;
-    std::fill(ppath_.begin(), ppath_.end(), 0.0);
+    ppaths_.assign(s_.detectors.empty() ? 0 : photons * labels_, 0.0);
+    record_photon_.clear();
+  }
+  /// Photon `slot` of the chunk walks on (a chunk's photons walk gate by gate, in turns).
+  void begin(size_t slot) {
+    slot_ = slot;
+    ppath_ = ppaths_.empty() ? nullptr : ppaths_.data() + slot * labels_;
   }
 
   void segment(const Segment& seg) {
     ++out_->segments;
     out_->absorbed[static_cast<size_t>(seg.label)] += seg.absorbed;
     out_->balance.absorbed += seg.absorbed;
-    if (!s_.detectors.empty()) ppath_[static_cast<size_t>(seg.label)] += seg.length();
+    if (ppath_) ppath_[static_cast<size_t>(seg.label)] += seg.length();
     if (s_.fluence && seg.duration > 0) fluence(seg);
   }
 
@@ -85,6 +92,10 @@ class Tally {
 
   void alive(const Photon& p) { out_->balance.alive += p.w; }
   void end() { flush(); }
+  /// The chunk's detected-photon records in photon order (they were made gate by gate).
+  void end_chunk() { sort_records(out_->records, record_photon_); }
+  /// Where the walk should record the voxel faces of its steps (nullptr: not needed).
+  VoxelCrossings* crossings() { return same_grid_ ? &crossings_ : nullptr; }
 
  private:
   static bool same_grid(const Setup& s) {
@@ -150,36 +161,56 @@ class Tally {
     if (same_grid_) {
       // The label grid's voxels along the segment; the weight factor exp(-mu_a s) is carried
       // from voxel to voxel.
-      const LabelVolume& vol = s_.volume;
       const TimeAxis& ax = s_.time;
       const double L = seg.distance, mu = seg.k / seg.v, inv_v = 1.0 / seg.v;
       const int j0 = ax.bin_of(seg.t0);
       const bool one_gate = j0 >= 0 && seg.t0 + seg.duration <= ax.bin_start_ps(j0 + 1);
       const size_t gate_offset = one_gate ? static_cast<size_t>(j0) * cells_ : 0;
+      double sa = 0, ea = 1;
+      auto piece = [&](int cx, int cy, int cz, double sb) {
+        if (!(sb > sa)) return;
+        const size_t c = layout_.index(cx, cy, cz);
+        if (one_gate) {
+          double e;
+          const double g = mean_decay(mu * (sb - sa), e);
+          add(c + gate_offset, seg.w0 * ea * (sb - sa) * g);
+          ea *= e;
+        } else {  // the segment crosses gates (or the window start): split exactly
+          deposit(seg, c, sa * inv_v, sb * inv_v);
+          ea = mu > 0 ? std::exp(-mu * sb) : 1.0;
+        }
+        sa = sb;
+      };
+      int cx = seg.cell[0], cy = seg.cell[1], cz = seg.cell[2];
+      const VoxelCrossings* vc = seg.crossings;
+      if (vc && vc->complete()) {  // the faces the walk's march crossed: no second march
+        const int step[3] = {seg.d[0] > 0 ? 1 : -1, seg.d[1] > 0 ? 1 : -1, seg.d[2] > 0 ? 1 : -1};
+        if (one_gate) {  // the sums are likely cache misses: ask for all of them at once
+          int c[3] = {cx, cy, cz};
+          const uint64_t* sums = sums_.fluence.data() + gate_offset;
+          __builtin_prefetch(sums + layout_.index(c[0], c[1], c[2]), 1);
+          for (int q = 0; q < vc->count; ++q) {
+            c[vc->axis[q]] += step[vc->axis[q]];
+            __builtin_prefetch(sums + layout_.index(c[0], c[1], c[2]), 1);
+          }
+        }
+        for (int q = 0; q < vc->count; ++q) {
+          piece(cx, cy, cz, vc->s[q]);
+          const int a = vc->axis[q];
+          (a == 0 ? cx : (a == 1 ? cy : cz)) += step[a];
+        }
+        piece(cx, cy, cz, L);
+        return;
+      }
+      const LabelVolume& vol = s_.volume;
       const VoxelDda dda(seg.x0, seg.d, seg.cell, vol.origin, Vec3(vol.voxel));
       // One label: every voxel is in the grid.
       double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
-      int cx = seg.cell[0], cy = seg.cell[1], cz = seg.cell[2];
-      double sa = 0, ea = 1;
       while (true) {
         const int a = tx < ty && tx < tz ? 0 : (!(tx < ty) && ty < tz ? 1 : 2);  // VoxelDda::axis()
         const double t = a == 0 ? tx : (a == 1 ? ty : tz);
-        const bool last = t >= L;
-        const double sb = last ? L : t;
-        if (sb > sa) {
-          const size_t c = layout_.index(cx, cy, cz);
-          if (one_gate) {
-            double e;
-            const double g = mean_decay(mu * (sb - sa), e);
-            add(c + gate_offset, seg.w0 * ea * (sb - sa) * g);
-            ea *= e;
-          } else {  // the segment crosses gates (or the window start): split exactly
-            deposit(seg, c, sa * inv_v, sb * inv_v);
-            ea = mu > 0 ? std::exp(-mu * sb) : 1.0;
-          }
-        }
-        if (last) break;
-        sa = sb;
+        if (t >= L) break;
+        piece(cx, cy, cz, t);
         if (a == 0)
           cx += dda.step[0], tx += dda.t_delta[0];
         else if (a == 1)
@@ -187,6 +218,7 @@ class Tally {
         else
           cz += dda.step[2], tz += dda.t_delta[2];
       }
+      piece(cx, cy, cz, L);
       return;
     }
     // Walk the fluence grid's cells along the segment (3-D DDA), clipped to its box.
@@ -260,7 +292,8 @@ class Tally {
       rec.scatterings.push_back(p.scatterings);
       rec.weight.push_back(p.w);
       rec.time_ps.push_back(p.t);
-      rec.ppath.insert(rec.ppath.end(), ppath_.begin() + 1, ppath_.end());
+      record_photon_.push_back(static_cast<uint32_t>(slot_));
+      rec.ppath.insert(rec.ppath.end(), ppath_ + 1, ppath_ + labels_);
       rec.exit.insert(rec.exit.end(), {p.x.x, p.x.y, p.x.z, p.d.x, p.d.y, p.d.z});
       return;  // a photon counts for the first detector it reaches
     }
@@ -278,7 +311,12 @@ class Tally {
   static constexpr size_t kNone = ~size_t{0};
   size_t pending_ = kNone;
   double pending_value_ = 0;
-  std::vector<double> ppath_;  // per label, this photon
+  size_t labels_;
+  std::vector<double> ppaths_;           // (photon of the chunk, label): partial path lengths
+  double* ppath_ = nullptr;              // this photon's row
+  size_t slot_ = 0;                      // this photon's place in the chunk
+  std::vector<uint32_t> record_photon_;  // per record: its photon's place in the chunk
+  VoxelCrossings crossings_;             // the faces of the current step, from the walk
   ChunkSums* out_ = nullptr;
 };
 

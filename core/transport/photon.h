@@ -3,6 +3,7 @@
 // the tissue transport (core/transport/tissue_walk.h) and `femto diffusion`: the walk yields
 // segments, tallies integrate them.
 #include <cmath>
+#include <cstdint>
 
 #include "core/vec3.h"
 
@@ -22,6 +23,21 @@ struct Photon {
   int face_axis = -1;       ///< axis of the last voxel face crossed or reflected at (tissue walk)
 };
 
+/// The voxel faces crossed inside one step of the tissue walk (filled by its march when a tally
+/// asks for them, so that a tally on the same grid need not march again): the distance along the
+/// step of each face and the axis it is normal to.
+struct VoxelCrossings {
+  static constexpr int kMax = 64;
+  int count = 0;  ///< faces crossed; above kMax only the first kMax are recorded
+  double s[kMax];
+  int8_t axis[kMax];
+  bool complete() const { return count <= kMax; }
+  void add(double at, int a) {
+    if (count < kMax) s[count] = at, axis[count] = static_cast<int8_t>(a);
+    ++count;
+  }
+};
+
 /// A straight piece of a path at constant speed (in the tissue walk: inside one label, across
 /// any number of its voxels): position x0 + d v tau and weight
 /// w0 exp(-k tau) for tau in [0, duration]; duration may be +inf (no further event).
@@ -37,6 +53,8 @@ struct Segment {
   double distance = 0;      ///< geometric length, mm (tissue walk; v * duration up to rounding)
   int label = 0;            ///< label of the region crossed (tissue walk: one label, many voxels)
   int cell[3] = {0, 0, 0};  ///< voxel of the start (tissue walk)
+  /// Set by the caller (or nullptr): the walk records there the voxel faces crossed in the step.
+  VoxelCrossings* crossings = nullptr;
   double length() const { return distance; }
 };
 

@@ -85,7 +85,8 @@ class UnboundedSpace {
   explicit UnboundedSpace(const TissueOptics& o) : o_(WalkOptics::of(o)) {}
   const WalkOptics& optics(int) const { return o_; }
   const WalkOptics& optics_at(const Photon&) const { return o_; }
-  double distance_to_interface(const Photon& p, double, int&, int end_cell[3]) const {
+  double distance_to_interface(const Photon& p, double, int&, int end_cell[3],
+                               VoxelCrossings*) const {
     for (int a = 0; a < 3; ++a) end_cell[a] = p.cell[a];
     return std::numeric_limits<double>::infinity();
   }
@@ -98,10 +99,10 @@ class UnboundedSpace {
 /// The march shared by the voxel spaces: the distance along p.d from p (in voxel p.cell of
 /// `vol`) to the first face whose neighbour is outside the grid or fails same(index of the
 /// neighbour in vol.labels), if it comes before s_stop (else +inf); see
-/// LabelSpace::distance_to_interface.
+/// LabelSpace::distance_to_interface. `crossed` (if not null) receives the faces crossed.
 template <class Same>
 double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, int& axis,
-                       int end_cell[3], Same same) {
+                       int end_cell[3], VoxelCrossings* crossed, Same same) {
   const VoxelDda dda(p.x, p.d, p.cell, vol.origin, Vec3(vol.voxel));
   // Scalars rather than arrays indexed by the moving axis keep the march in registers; the
   // voxel's index moves by a fixed stride per axis.
@@ -111,6 +112,7 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
   const ptrdiff_t sy = dda.step[1] * static_cast<ptrdiff_t>(vol.n[2]), sz = dda.step[2];
   ptrdiff_t i = static_cast<ptrdiff_t>(vol.index(cx, cy, cz));  // a tissue voxel: in the grid
   double s = std::numeric_limits<double>::infinity();
+  if (crossed) crossed->count = 0;
   while (true) {
     if (tx < ty && tx < tz) {  // the same choice as VoxelDda::axis()
       if (tx >= s_stop) break;
@@ -119,6 +121,7 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
         s = tx, axis = 0;
         break;
       }
+      if (crossed) crossed->add(tx, 0);
       cx = c, i += sx, tx += dda.t_delta[0];
     } else if (!(tx < ty) && ty < tz) {
       if (ty >= s_stop) break;
@@ -127,6 +130,7 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
         s = ty, axis = 1;
         break;
       }
+      if (crossed) crossed->add(ty, 1);
       cy = c, i += sy, ty += dda.t_delta[1];
     } else {
       if (tz >= s_stop) break;
@@ -135,6 +139,7 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
         s = tz, axis = 2;
         break;
       }
+      if (crossed) crossed->add(tz, 2);
       cz = c, i += sz, tz += dda.t_delta[2];
     }
   }
@@ -200,11 +205,13 @@ class LabelSpace {
   /// Distance along p.d to the first voxel face where the label changes, if it comes before
   /// s_stop (else +inf); `axis` is that face's axis. end_cell: the voxel holding the end of the
   /// piece (the last voxel before that face, or the voxel at s_stop). Faces between voxels of
-  /// the same label are crossed here, without a step of the walk.
-  double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3]) const {
+  /// the same label are crossed here, without a step of the walk (recorded in `crossed`, if not
+  /// null).
+  double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3],
+                               VoxelCrossings* crossed) const {
     const uint16_t* labels = vol_.labels.data();
     const uint16_t label = static_cast<uint16_t>(p.label);
-    return march_to_change(vol_, p, s_stop, axis, end_cell,
+    return march_to_change(vol_, p, s_stop, axis, end_cell, crossed,
                            [&](ptrdiff_t i) { return labels[i] == label; });
   }
 
@@ -227,9 +234,14 @@ class LabelSpace {
 };
 
 /// 1 - exp(-x) for x >= 0, to a relative error below 1e-13, cheaper than std::expm1: a series
-/// for small x, where 1 - exp(-x) would cancel.
+/// for x < 0.05 (a step's mu_a s in most tissues: no exponential), where 1 - exp(-x) would
+/// also cancel; truncated after x^7, the error is below x^7 / 8! / x < 2e-14.
 inline double one_minus_exp(double x) {
-  if (x < 1e-3) return x * (1 - x * (0.5 - x * (1.0 / 6 - x * (1.0 / 24))));
+  if (x < 0.05)
+    return x *
+           (1 - x * (1.0 / 2 -
+                     x * (1.0 / 6 -
+                          x * (1.0 / 24 - x * (1.0 / 120 - x * (1.0 / 720 - x * (1.0 / 5040)))))));
   return 1 - std::exp(-x);
 }
 
@@ -245,7 +257,8 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   int axis = 0, end_cell[3];
   const double s_event = rate > 0 ? p.tau_left / rate : kInf;
   const double s_window = (ws.t_end - p.t) * o.v;
-  const double s_face = space.distance_to_interface(p, std::min(s_event, s_window), axis, end_cell);
+  const double s_face =
+      space.distance_to_interface(p, std::min(s_event, s_window), axis, end_cell, seg.crossings);
   StepEvent ev;
   double s;
   if (s_face < s_event && s_face < s_window) {

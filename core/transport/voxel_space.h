@@ -29,10 +29,11 @@ class VoxelSpace {
   }
 
   /// As LabelSpace::distance_to_interface, with "the same optics" in place of "the same label".
-  double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3]) const {
+  double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3],
+                               VoxelCrossings* crossed) const {
     const VoxelOptics* optics = vol_.voxel_optics.data();
     const VoxelOptics here = voxel(p.cell);
-    return march_to_change(vol_, p, s_stop, axis, end_cell,
+    return march_to_change(vol_, p, s_stop, axis, end_cell, crossed,
                            [&](ptrdiff_t i) { return optics[i] == here; });
   }
 
