@@ -48,6 +48,7 @@ void tracking(int n) {
   const double mean = grid.mean_sigma_t();
   std::printf("tracking: %d^3 cloud, voxel %.1f mm, sigma_t = %.2f * density (max %.3f, mean %.4f /mm)\n", n,
               voxel, desc.sigma_t_scale, grid.max_sigma_t(), mean);
+  std::printf("  CPU: %s\n", bench::cpu_model().c_str());
   std::printf("  dense fields %.1f MiB, block structure (%d^3-cell blocks: max sigma_t, index) %.1f KiB\n",
               static_cast<double>(grid.field_memory_bytes()) / (1 << 20), GridMedium::kBlock,
               static_cast<double>(grid.block_memory_bytes()) / 1024);

@@ -3,6 +3,7 @@
 // the random walk that the medium benchmarks time.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <string>
@@ -47,9 +48,13 @@ inline double walk_rate(int walks, double half, MakeSegments make_segments, uint
     Vec3 x(0, 0, 0);
     for (int step = 0; step < 100000; ++step) {
       const Vec3 d = sample_uniform_sphere(rng.uniform(), rng.uniform());
-      double s_exit = 1e30;  // distance to the box boundary
-      for (int a = 0; a < 3; ++a)
-        if (d[a] != 0) s_exit = std::min(s_exit, ((d[a] > 0 ? half : -half) - x[a]) / d[a]);
+      // Distance to the box boundary, without branches on the signs of d: they are random, and
+      // their mispredictions cost more than the direction sample. d[a] = +-0 gives +inf.
+      double s_exit = 1e30;
+      for (int a = 0; a < 3; ++a) {
+        const double s_a = (std::copysign(half, d[a]) - x[a]) / d[a];
+        s_exit = s_a < s_exit ? s_a : s_exit;
+      }
       auto segments = make_segments(Ray{x, d}, s_exit);
       const DistanceEvent ev = sample_distance(segments, mfp, rng.uniform());
       if (!ev.collided) break;

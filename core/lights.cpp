@@ -5,6 +5,7 @@
 
 #include "core/constants.h"
 #include "core/sampling.h"
+#include "core/sincos_2pi.h"
 
 namespace femto {
 
@@ -215,9 +216,9 @@ bool LightSet::sample_emission(int i, double u1, double u2, double u3, double u4
       // Uniform in the cone's solid angle, weighted by the smooth falloff.
       const double cos_t = 1.0 - u1 * (1.0 - l.cos_cone);
       const double sin_t = std::sqrt(std::fmax(0.0, 1.0 - cos_t * cos_t));
-      const double phi = 2.0 * kPi * u2;
-      const Vec3 d = normalize(
-          Frame(l.direction).to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t}));
+      const SinCos phi = sincos_2pi(u2);
+      const Vec3 d =
+          normalize(Frame(l.direction).to_world({sin_t * phi.cos, sin_t * phi.sin, cos_t}));
       const double falloff = smoothstep(l.cos_cone, l.cos_falloff, cos_t);
       if (!(falloff > 0)) return false;
       e.ray = {l.position, d};

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/constants.h"
+#include "core/sincos_2pi.h"
 #include "core/vec3.h"
 
 namespace femto {
@@ -10,8 +11,8 @@ namespace femto {
 /// Cosine-weighted direction in the local frame (z up); pdf = cos(theta) / pi per steradian.
 inline Vec3 sample_cosine_hemisphere(double u1, double u2) {
   const double r = std::sqrt(u1);
-  const double phi = 2.0 * kPi * u2;
-  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::fmax(0.0, 1.0 - u1))};
+  const SinCos phi = sincos_2pi(u2);
+  return {r * phi.cos, r * phi.sin, std::sqrt(1.0 - u1)};  // 1 - u1 >= 0 in floating point too
 }
 inline double cosine_hemisphere_pdf(double cos_theta) {
   return cos_theta > 0.0 ? cos_theta * kInvPi : 0.0;
@@ -20,17 +21,17 @@ inline double cosine_hemisphere_pdf(double cos_theta) {
 /// Uniform direction on the unit sphere; pdf = 1 / (4 pi).
 inline Vec3 sample_uniform_sphere(double u1, double u2) {
   const double z = 1.0 - 2.0 * u1;
-  const double r = std::sqrt(std::fmax(0.0, 1.0 - z * z));
-  const double phi = 2.0 * kPi * u2;
-  return {r * std::cos(phi), r * std::sin(phi), z};
+  const double r = 2.0 * std::sqrt(u1 * (1.0 - u1));  // sqrt(1 - z^2), without its cancellation
+  const SinCos phi = sincos_2pi(u2);
+  return {r * phi.cos, r * phi.sin, z};
 }
 
 /// Uniform point on a disc of radius 1; pdf = 1 / pi per unit area.
 inline void sample_uniform_disc(double u1, double u2, double& x, double& y) {
   const double r = std::sqrt(u1);
-  const double phi = 2.0 * kPi * u2;
-  x = r * std::cos(phi);
-  y = r * std::sin(phi);
+  const SinCos phi = sincos_2pi(u2);
+  x = r * phi.cos;
+  y = r * phi.sin;
 }
 
 /// Barycentrics (b1, b2) of a uniform point on a triangle; pdf = 1 / area.

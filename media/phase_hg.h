@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/constants.h"
+#include "core/sincos_2pi.h"
 #include "core/vec3.h"
 
 namespace femto {
@@ -34,9 +35,9 @@ inline PhaseSample hg_sample(const Vec3& d, double g, double u1, double u2) {
   const double cos_t = hg_sample_cos(u1, g);
   const double sin2_t = 1.0 - cos_t * cos_t;
   const double sin_t = std::sqrt(sin2_t > 0.0 ? sin2_t : 0.0);
-  const double phi = 2.0 * kPi * u2;
+  const SinCos phi = sincos_2pi(u2);
   const Frame f(d);
-  const Vec3 dir = f.to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t});
+  const Vec3 dir = f.to_world({sin_t * phi.cos, sin_t * phi.sin, cos_t});
   return {normalize(dir), hg_eval(cos_t, g)};
 }
 

@@ -21,6 +21,7 @@
 #include <cmath>
 
 #include "core/constants.h"
+#include "core/sincos_2pi.h"
 #include "core/vec3.h"
 
 namespace femto {
@@ -82,9 +83,9 @@ class AngularTimeSampler {
   Vec3 sample_direction(const Vec3& to_target, const Window& w, double u1, double u2) const {
     const double omc = sample_one_minus_cos(w, u1);
     const double cos_t = 1.0 - omc, sin_t = std::sqrt(std::max(0.0, omc * (2.0 - omc)));
-    const double phi = 2.0 * kPi * u2;
+    const SinCos phi = sincos_2pi(u2);
     const Frame f(to_target);
-    return f.to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t});
+    return f.to_world({sin_t * phi.cos, sin_t * phi.sin, cos_t});
   }
 
   /// Density of cos theta (per unit cos theta).

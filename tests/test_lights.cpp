@@ -2,10 +2,12 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <vector>
 
 #include "core/constants.h"
 #include "core/lights.h"
 #include "core/rng.h"
+#include "samplers/stats.h"
 #include "scene_builders.h"
 
 using namespace femto;
@@ -71,6 +73,52 @@ TEST_CASE("spot light cone and falloff", "[lights]") {
   CHECK(ls.Li.r < 10.0 / 4.0);
   CHECK_FALSE(at_angle(31, ls));
   CHECK_FALSE(at_angle(120, ls));
+}
+
+// Catches: spot emission directions that are not uniform over the cone's solid angle (a wrong
+// cos theta warp, or an azimuth that is not uniform, e.g. a wrong quadrant of its sine/cosine).
+// Chi-square over 10 bands of cos theta x 16 azimuth sectors, fixed seed, reject when p < 1e-3.
+TEST_CASE("spot light emission is uniform over its cone", "[lights]") {
+  SceneDesc d;
+  LightDesc l;
+  l.type = LightDesc::Type::Spot;
+  l.position = {1, 2, 3};
+  l.direction = normalize(Vec3(0.3, -0.4, 0.8));
+  l.intensity = RGB(1.0);
+  l.cone_angle_deg = 40;
+  l.falloff_deg = 25;
+  d.lights.push_back(l);
+  const LightSet lights(d);
+  const Frame frame(l.direction);
+  const double cos_cone = std::cos(40.0 * kPi / 180.0);
+  const int n_mu = 10, n_phi = 16, n = 160000;
+  std::vector<double> observed(n_mu * n_phi, 0.0);
+  Rng rng(41, 9);
+  int rejected = 0, off_cone = 0;
+  for (int k = 0; k < n; ++k) {
+    LightEmission e;
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    if (!lights.sample_emission(0, u1, u2, 0.5, 0.5, e)) {
+      ++rejected;
+      continue;
+    }
+    const Vec3 w = frame.to_local(e.ray.d);
+    if (w.z < cos_cone - 1e-12 || std::abs(length(e.ray.d) - 1.0) > 1e-15) {
+      ++off_cone;
+      continue;
+    }
+    double phi = std::atan2(w.y, w.x);
+    if (phi < 0) phi += 2.0 * kPi;
+    const int i = std::min(n_mu - 1, static_cast<int>((1.0 - w.z) / (1.0 - cos_cone) * n_mu));
+    const int j = std::min(n_phi - 1, static_cast<int>(phi / (2.0 * kPi) * n_phi));
+    observed[static_cast<size_t>(i * n_phi + j)] += 1.0;
+  }
+  CHECK(rejected == 0);
+  CHECK(off_cone == 0);
+  const std::vector<double> expected(observed.size(), static_cast<double>(n) / (n_mu * n_phi));
+  const stats::Chi2Result r = stats::chi2_test(observed, expected);
+  INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
+  CHECK(r.p_value >= 1e-3);
 }
 
 // Catches: laser irradiance or geometry errors (points behind the source or outside the beam).

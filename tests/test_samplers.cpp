@@ -240,6 +240,36 @@ TEST_CASE("Uniform sphere warp is uniform", "[samplers][warps]") {
   CHECK(r.p_value >= kAlpha);
 }
 
+// Catches direction samplers whose output drifts off the unit sphere beyond rounding (an azimuth
+// sine/cosine or a radius sqrt(1 - z^2) with errors of many ulps, e.g. from cancellation near the
+// poles), which every later dot product and pdf would inherit. Lengths in long double.
+TEST_CASE("Sampled directions are unit vectors to 1e-15", "[samplers][warps]") {
+  const auto length_error = [](const Vec3& w) {
+    const long double x = w.x, y = w.y, z = w.z;
+    return static_cast<double>(std::fabs(std::sqrt(x * x + y * y + z * z) - 1.0L));
+  };
+  Rng rng(5, 8);
+  double sphere = 0.0, hemisphere = 0.0, hg = 0.0, disc = 0.0;
+  for (int k = 0; k < 300000; ++k) {
+    // Every fourth u1 next to 0 or 1, where sqrt(1 - z^2) used to cancel.
+    double u1 = rng.uniform();
+    if (k % 4 == 0) u1 = (k % 8 == 0 ? 1.0 - u1 * 1e-9 : u1 * 1e-9);
+    const double u2 = rng.uniform();
+    sphere = std::fmax(sphere, length_error(femto::sample_uniform_sphere(u1, u2)));
+    hemisphere = std::fmax(hemisphere, length_error(femto::sample_cosine_hemisphere(u1, u2)));
+    hg = std::fmax(hg, length_error(femto::hg_sample(kIncoming, 0.7, u1, u2).dir));
+    double x = 0.0, y = 0.0;
+    femto::sample_uniform_disc(1.0, u2, x, y);  // the rim: radius exactly 1
+    disc = std::fmax(disc, std::fabs(std::hypot(x, y) - 1.0));
+  }
+  INFO("max | |w| - 1 |: sphere " << sphere << ", cosine hemisphere " << hemisphere << ", HG " << hg
+                                  << ", disc rim " << disc);
+  CHECK(sphere <= 1e-15);
+  CHECK(hemisphere <= 1e-15);
+  CHECK(hg <= 1e-15);
+  CHECK(disc <= 1e-15);
+}
+
 // Catches a disc warp with r = u1 (clustered centre) instead of sqrt(u1).
 TEST_CASE("Uniform disc warp is uniform", "[samplers][warps]") {
   const auto r = chi2_grid(

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "core/constants.h"
+#include "core/sincos_2pi.h"
 #include "core/vec3.h"
 
 namespace femto {
@@ -58,10 +59,11 @@ struct Ggx {
     const Vec3 t2 = cross(wh, t1);
     // A uniform point on the unit disc, squeezed into the hemisphere's projection seen from wh:
     // a full half-disc plus the part of the other half scaled by wh.z.
-    const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
-    const double p1 = r * std::cos(phi);
+    const double r = std::sqrt(u1);
+    const SinCos phi = sincos_2pi(u2);
+    const double p1 = r * phi.cos;
     const double s = 0.5 * (1.0 + wh.z);
-    const double p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * r * std::sin(phi);
+    const double p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * r * phi.sin;
     // Lift onto the hemisphere, then unstretch the normal.
     const double p3 = std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2));
     const Vec3 nh = t1 * p1 + t2 * p2 + wh * p3;
