@@ -6,6 +6,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/info_format.h"
 #include "apps/tissue_info.h"
 #include "core/error.h"
 #include "core/mitsuba/mitsuba_xml.h"
@@ -36,19 +37,11 @@ const char* kInfoHelp =
     "                  (repeatable; also --define NAME=VALUE)\n"
     "  --help          this help\n";
 
-std::string g6(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-std::string vec(const Vec3& v) {
-  return "[" + g6(v.x) + ", " + g6(v.y) + ", " + g6(v.z) + "]";
-}
+using info::g6;
+using info::range;
+using info::vec;
 std::string rgb(const RGB& c) {
   return c.r == c.g && c.g == c.b ? g6(c.r) : "[" + g6(c.r) + ", " + g6(c.g) + ", " + g6(c.b) + "]";
-}
-std::string range(double lo, double hi) {
-  return lo == hi ? g6(lo) : g6(lo) + " to " + g6(hi);
 }
 
 std::string pulse(const PulseDesc& p) {

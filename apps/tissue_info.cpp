@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "apps/cli.h"
+#include "apps/info_format.h"
 #include "core/error.h"
 #include "core/tissue/scene.h"
 #include "core/tissue/simulate.h"
@@ -13,17 +14,9 @@
 namespace femto {
 
 namespace {
-std::string g6(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
-std::string vec(const Vec3& v) {
-  return "[" + g6(v.x) + ", " + g6(v.y) + ", " + g6(v.z) + "]";
-}
-std::string range(double lo, double hi) {
-  return lo == hi ? g6(lo) : g6(lo) + " to " + g6(hi);
-}
+using info::g6;
+using info::range;
+using info::vec;
 
 const char* source_name(tissue::Source::Type t) {
   using T = tissue::Source::Type;
