@@ -7,10 +7,9 @@
 // rare large errors, the tail, dominate). The default configuration is marked.
 //
 // Error measure: per cell (pixel x bin, channels summed), the mean squared error of one render
-// against the mean of all *other* configurations (all estimate the same light; leaving the
-// configuration out keeps its error uncorrelated with the reference), times the 1-thread render
-// time. A squared error, not a variance: an estimator whose rare large values most runs miss
-// shows up as a shortfall in every run.
+// against a long reference render (32x the samples, seeds of its own, so uncorrelated with every
+// configuration), times the 1-thread render time. A squared error, not a variance: an estimator
+// whose rare large values most runs miss shows up as a shortfall in every run.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -35,13 +34,14 @@ struct BenchScene {
   const char* name;
   std::string json;
   int spp;  ///< per render, so that a render takes a fraction of a second
-  /// Cells count when the pooled estimate exceeds this fraction of the film's peak (0: every
+  /// Cells count when the reference exceeds this fraction of the film's peak (0: every
   /// cell with light, for scenes whose late frames are many decades dimmer than the first).
   double min_signal = 0.01;
-  /// > 0: errors are measured against one long reference render (`mis + mis`, this many times
-  /// the spp, seeds of its own) instead of the mean of the other configurations, whose noise in
-  /// dim late cells would swamp the errors of the good estimators.
-  int reference_factor = 0;
+  /// Errors are measured against one long reference render (`mfp + mis`, this many times the
+  /// spp, seeds of its own): independent of every configuration measured, and free of the rare
+  /// huge weights of time-uniform distances, which made a mean of the configurations fall short
+  /// in dense media.
+  int reference_factor = 32;
 };
 
 /// A box of homogeneous medium (half-width `half`) with a point light at (0.2, 0.3, light_z) x
@@ -64,8 +64,8 @@ std::string box_scene(double half, double sigma_a, double sigma_s, double g, dou
     "shapes": [ { "type": "box", "min": [%g, %g, %g], "max": [%g, %g, %g], "medium": "m" } ],
     "lights": [ %s ]
   })",
-                6 * half, t_start, bin_ps, sigma_a, sigma_s, g, eta, -half, -half, -half, half, half, half,
-                light);
+                6 * half, t_start, bin_ps, sigma_a, sigma_s, g, eta, -half, -half, -half, half,
+                half, half, light);
   return buf;
 }
 
@@ -161,52 +161,35 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
       films[static_cast<size_t>(k)].push_back(std::move(c));
     }
   const size_t cells = films[0][0].size();
-  std::vector<std::vector<double>> mean(static_cast<size_t>(n), std::vector<double>(cells, 0.0));
-  for (int k = 0; k < n; ++k)
-    for (const auto& f : films[static_cast<size_t>(k)])
-      for (size_t i = 0; i < cells; ++i)
-        mean[static_cast<size_t>(k)][i] += static_cast<double>(f[i]) / reps;
-  std::vector<double> pooled(cells, 0.0);
-  for (int k = 0; k < n; ++k)
-    for (size_t i = 0; i < cells; ++i) pooled[i] += mean[static_cast<size_t>(k)][i] / n;
-  std::vector<double> long_ref;
-  if (bs.reference_factor > 0) {
-    RenderOptions opt;
-    opt.spp = spp * bs.reference_factor;
-    opt.threads = 0;
-    opt.quiet = true;
-    opt.seed = 1000003;
-    const RenderResult res = render(*scenes[1], opt);  // mis + mis
-    long_ref.resize(cells);
-    for (size_t i = 0; i < cells; ++i)
-      long_ref[i] = static_cast<double>(res.film.transient()[3 * i]) +
-                    res.film.transient()[3 * i + 1] + res.film.transient()[3 * i + 2];
-    pooled = long_ref;
-  }
-  const double peak = percentile(pooled, 0.999);
+  RenderOptions ref_opt;
+  ref_opt.spp = spp * bs.reference_factor;
+  ref_opt.threads = 0;
+  ref_opt.quiet = true;
+  ref_opt.seed = 1000003;
+  const RenderResult ref_res = render(*scenes[4], ref_opt);  // mfp + mis
+  std::vector<double> ref(cells);
+  for (size_t i = 0; i < cells; ++i)
+    ref[i] = static_cast<double>(ref_res.film.transient()[3 * i]) +
+             ref_res.film.transient()[3 * i + 1] + ref_res.film.transient()[3 * i + 2];
+  const double peak = percentile(ref, 0.999);
   auto mse_of = [&](int k) {
     std::vector<double> mse(cells, 0.0);
-    for (size_t i = 0; i < cells; ++i) {
-      const double ref = !long_ref.empty()
-                             ? long_ref[i]
-                             : (pooled[i] * n - mean[static_cast<size_t>(k)][i]) / (n - 1);
+    for (size_t i = 0; i < cells; ++i)
       for (const auto& f : films[static_cast<size_t>(k)])
-        mse[i] += (f[i] - ref) * (f[i] - ref) / reps;
-    }
+        mse[i] += (f[i] - ref[i]) * (f[i] - ref[i]) / reps;
     return mse;
   };
   const int c_ref = n - 1;
   const std::vector<double> mse_c = mse_of(c_ref);
   const double time_c = median(secs[static_cast<size_t>(c_ref)]);
-  double pooled_total = 0;
-  for (size_t i = 0; i < cells; ++i) pooled_total += pooled[i];
+  double ref_total = 0;
+  for (size_t i = 0; i < cells; ++i) ref_total += ref[i];
   std::printf("\n%s: %d x %d px, %d bins, %d spp x %d seeds, %.2f medium events per path\n",
               bs.name, width, height, bins, spp, reps,
               static_cast<double>(stats[static_cast<size_t>(c_ref)].medium_events) /
                   static_cast<double>(stats[static_cast<size_t>(c_ref)].paths));
   std::printf("  %-27s %10s %12s %12s %12s %18s\n", "configuration", "paths/s", "median eff.",
-              "late eff.", "film eff.",
-              !long_ref.empty() ? "total vs reference" : "total vs pooled");
+              "late eff.", "film eff.", "total vs reference");
   for (int k = 0; k < n; ++k) {
     const double t = median(secs[static_cast<size_t>(k)]);
     const std::vector<double> mse = mse_of(k);
@@ -215,7 +198,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
     for (size_t i = 0; i < cells; ++i) {
       sum_mse += mse[i];
       sum_mse_c += mse_c[i];
-      if (!(pooled[i] > bs.min_signal * peak && mse[i] > 0 && mse_c[i] > 0)) continue;
+      if (!(ref[i] > bs.min_signal * peak && mse[i] > 0 && mse_c[i] > 0)) continue;
       const double e = (mse_c[i] * time_c) / (mse[i] * t);
       all.push_back(e);
       if (static_cast<int>(i % static_cast<size_t>(bins)) >= 2 * bins / 3) late.push_back(e);
@@ -224,7 +207,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale) {
     for (const auto& f : films[static_cast<size_t>(k)]) {
       double sum = 0;
       for (size_t i = 0; i < cells; ++i) sum += f[i];
-      totals.push_back(sum / pooled_total);
+      totals.push_back(sum / ref_total);
     }
     double tm = 0, tv = 0;
     for (double x : totals) tm += x / reps;
@@ -294,16 +277,18 @@ int main(int argc, char** argv) {
       // The time-uniform regime (corridor_scene): a narrow corridor of grey fog (albedo 0.5),
       // and a wide one of brighter fog (albedo 0.8) whose multiply scattered light also reaches
       // the late frames.
-      {"fog corridor, long window", corridor_scene(0.004, 0.5, 5), 2048, 0.0, 32},
-      {"wide fog corridor, long window", corridor_scene(0.004, 0.8, 20), 2048, 0.0, 32},
+      {"fog corridor, long window", corridor_scene(0.004, 0.5, 5), 2048, 0.0},
+      {"wide fog corridor, long window", corridor_scene(0.004, 0.8, 20), 2048, 0.0},
   };
   const std::string cloud = "data/volumes/cloud.vdb";
   if (std::filesystem::exists(cloud)) {
-    list.push_back({"voxel cloud", R"({
+    list.push_back({"voxel cloud",
+                    R"({
       "camera": { "type": "perspective", "position": [0, 0, 400], "look_at": [0, 0, 0], "fov": 26,
                   "resolution": [32, 32] },
       "time": { "start_opl": 360, "bin_width_opl": 4, "bins": 150 },
-      "media": { "cloud": { "type": "vdb", "file": ")" + cloud + R"(", "density_grid": "density",
+      "media": { "cloud": { "type": "vdb", "file": ")" +
+                        cloud + R"(", "density_grid": "density",
                             "sigma_t_scale": 0.08, "albedo": 0.95, "g": 0.6 } },
       "medium": "cloud",
       "lights": [ { "type": "point", "position": [20, 30, 10], "intensity": 1000 } ]
@@ -312,9 +297,10 @@ int main(int argc, char** argv) {
   } else {
     std::printf("(no %s here: run from the repository root for the voxel cloud)\n", cloud.c_str());
   }
-  std::printf("femto-bench-sampling: CPU %s; 1 thread; efficiency = (MSE x time) of mfp + "
-              "collision over the configuration's, per pixel-bin cell (> 1: better); * = default\n",
-              cpu_model().c_str());
+  std::printf(
+      "femto-bench-sampling: CPU %s; 1 thread; efficiency = (MSE x time) of mfp + "
+      "collision over the configuration's, per pixel-bin cell (> 1: better); * = default\n",
+      cpu_model().c_str());
   for (const BenchScene& bs : list)
     if (only.empty() || only == bs.name) run_scene(bs, reps, spp_scale);
   return 0;

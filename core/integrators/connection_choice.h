@@ -10,6 +10,11 @@
 // collisions rarely hit, while equiangular sampling spreads over the light's angles and so over
 // the cone. The choice depends only on the segment and the light, never on a sampled distance, so
 // the two estimators split the light between them without bias.
+// Second rule, for the frames a camera segment reaches late: when its reachable part spans many
+// mean free paths and the light lies behind its start (a source beside the camera: the light
+// term falls from the start on and covers all the segment's frames), collisions leave the late
+// frames almost empty. Such a segment keeps its collisions and adds one line-to-point connection
+// (uniform in time), the two weighted by the balance heuristic.
 #include <cmath>
 #include <limits>
 
@@ -51,6 +56,25 @@ inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, doub
     w2 = std::fmax(length_squared(l) - delta * delta, 0.0);
   constexpr double k2 = kConnectionPeakFraction * kConnectionPeakFraction;
   return mfp_spread ? w2 * sigma_t * sigma_t < k2 : w2 < k2 * s_full * s_full;
+}
+
+/// Optical depth of a camera segment's reachable part beyond which auto adds a line-to-point
+/// connection: collisions put a fraction exp(-tau) of their density at depth tau, so the frames
+/// that look there get few vertices, while line-to-point sampling is uniform in time.
+constexpr double kStarvedDepth = 3.0;
+
+/// Whether a camera segment of length s_surf, with extinction sigma_t (spread_sigma_t) and
+/// `budget` mm of light travel left in the window, spans so many mean free paths that its later
+/// frames starve under collision sampling.
+inline bool starved_segment(double s_surf, double budget, double sigma_t) {
+  return sigma_t * std::fmin(s_surf, budget) >= kStarvedDepth;
+}
+
+/// Whether the point light p lies behind the start o of a segment along d: then its direct term
+/// along the segment falls from the start on and spans all of the segment's frames (a source
+/// beside the camera), instead of peaking at the light's foot.
+inline bool lights_from_start(const Vec3& o, const Vec3& d, const Vec3& p) {
+  return dot(p - o, d) <= 0.0;
 }
 
 /// The auto rule for one light: spot lights always connect (their cone), point lights by

@@ -137,11 +137,42 @@ double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& 
   return pdf > 0 ? hg_eval(dot(d, w), g) / pdf : 0.0;
 }
 
-void VolPathIntegrator::estimate_segment(const Medium& med, int m, const ConnectedSegment& segment,
-                                         const RGB& beta, double t, double t_factor, Rng& rng,
-                                         PixelAccumulator& acc, PathStats& stats) const {
+VolPathIntegrator::LineToPointTarget VolPathIntegrator::line_to_point_target(
+    const Medium& med, const ConnectedSegment& segment, const Light& L, bool narrow) const {
   const Ray& ray = segment.ray;
-  const double s_surf = segment.s_surf;
+  const double t = segment.t, t_factor = segment.t_factor;
+  LineToPointTarget target{
+      false, 0.0, LineToPointSampler(ray.o, ray.d, L.position, med.eta_at(ray.o)), {}};
+  // No vertex whose path passes the cut-off: with eta >= 1 the time of s and its connection is at
+  // least (s + d) / c with d >= s - |p - o|; an unwarped camera segment counts only d.
+  const double l = length(L.position - ray.o), budget = kSpeedOfLight * (t_cut_ - t);
+  const double reach = t_factor > 0 ? 0.5 * (budget + l) : budget + l;
+  target.s_end = std::min(segment.s_surf, reach);
+  if (!(target.s_end > 0) || !narrow) return target;
+  double t_a, t_b;
+  connection_window(filter_.axis(), L, t, t_a, t_b);
+  // Unwarped camera segment: the film time leaves out s, so cover every s whose connection can
+  // land.
+  if (!(t_factor > 0)) t_b += target.lp.eta() * target.s_end / kSpeedOfLight;
+  target.win = target.lp.window(t_a, t_b, 0.0, target.s_end);
+  target.valid = target.win.valid;
+  return target;
+}
+
+double VolPathIntegrator::collision_density(const Medium& med, int m, const Ray& ray,
+                                            double s) const {
+  double tau, opl;
+  tracker_.segment_integrals(m, ray, s, tau, opl);
+  const double sigma_t =
+      med.type == Medium::Type::Grid ? med.grid->sigma_t_at(ray.at(s)) : med.homogeneous.sigma_t();
+  return sigma_t * std::exp(-tau);
+}
+
+void VolPathIntegrator::estimate_segment(const Medium& med, int m, const ConnectedSegment& segment,
+                                         const RGB& beta, Rng& rng, PixelAccumulator& acc,
+                                         PathStats& stats) const {
+  const Ray& ray = segment.ray;
+  const double t = segment.t, t_factor = segment.t_factor;
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
@@ -151,51 +182,51 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Connect
   if (!is_point_like(L)) return;  // area lights and lasers: next-event estimation at collisions
   const Vec3& p = L.position;
   const ConnectionSampling kind = med.connection;
-  if (!segment.covers(L)) return;  // collision next-event estimation's share
-  // No vertex whose path passes the cut-off: with eta >= 1 the time of s and its connection is at
-  // least (s + d) / c with d >= s - |p - o|; an unwarped camera segment counts only d.
-  const double l = length(p - ray.o), budget = kSpeedOfLight * (t_cut_ - t);
-  const double reach = t_factor > 0 ? 0.5 * (budget + l) : budget + l;
-  const double s_end = std::min(s_surf, reach);
-  if (!(s_end > 0)) return;
+  // The partition's share (connections alone), or on a time_mis segment the connection's half of
+  // its MIS with the collisions.
+  const bool partition = segment.covers(L);
+  if (!partition && !segment.mis_with_collisions(L))
+    return;  // collision next-event estimation's share
 
-  // auto connects only where the light term peaks narrowly: equiangular's case (one sample).
-  const bool use_eq = kind != ConnectionSampling::LineToPoint;
-  const bool use_lp = kind == ConnectionSampling::LineToPoint || kind == ConnectionSampling::Mis;
+  // auto's partition connects only where the light term peaks narrowly: equiangular's case.
+  const bool use_eq = partition && kind != ConnectionSampling::LineToPoint;
+  const bool use_lp =
+      !partition || kind == ConnectionSampling::LineToPoint || kind == ConnectionSampling::Mis;
+  const LineToPointTarget target = !partition && segment.lp_target
+                                       ? *segment.lp_target
+                                       : line_to_point_target(med, segment, L, use_lp);
+  const double s_end = target.s_end;
+  if (!(s_end > 0)) return;
   const EquiangularSampler eq(ray.o, ray.d, p, 0.0, s_end);
-  const double eta0 = med.eta_at(ray.o);
-  const LineToPointSampler lp(ray.o, ray.d, p, eta0);
-  double t_a, t_b;
-  connection_window(filter_.axis(), L, t, t_a, t_b);
-  // Unwarped camera segment: the film time leaves out s, so cover every s whose connection can
-  // land.
-  if (!(t_factor > 0)) t_b += eta0 * s_end / kSpeedOfLight;
-  const LineToPointSampler::Window win =
-      use_lp ? lp.window(t_a, t_b, 0.0, s_end) : LineToPointSampler::Window{};
-  const bool eq_ok = use_eq && eq.valid(), lp_ok = use_lp && win.valid;
+  const bool eq_ok = use_eq && eq.valid(), lp_ok = use_lp && target.valid;
 
   auto contribute = [&](double s) {
-    // Multi-sample balance heuristic: f / (sum of the strategies' densities).
-    const double p_sum = (eq_ok ? eq.pdf(s) : 0.0) + (lp_ok ? lp.pdf(win, s) : 0.0);
-    if (!(p_sum > 0) || !(s < s_end)) return;
+    if (!(s < s_end)) return;
     const Vec3 y = ray.at(s);
     double tau, opl;
     tracker_.segment_integrals(m, ray, s, tau, opl);
-    const double sigma_s = med.type == Medium::Type::Grid
-                               ? med.grid->sigma_t_at(y) * med.grid->albedo_at(y)
-                               : med.homogeneous.sigma_s;
+    const double T = std::exp(-tau);
+    const double sigma_t =
+        med.type == Medium::Type::Grid ? med.grid->sigma_t_at(y) : med.homogeneous.sigma_t();
+    // Multi-sample balance heuristic: f / (sum of the strategies' densities); the collisions'
+    // density sigma_t T joins on time_mis segments.
+    const double p_sum = (eq_ok ? eq.pdf(s) : 0.0) + (lp_ok ? target.lp.pdf(target.win, s) : 0.0) +
+                         (partition ? 0.0 : sigma_t * T);
+    if (!(p_sum > 0)) return;
+    const double sigma_s =
+        med.type == Medium::Type::Grid ? sigma_t * med.grid->albedo_at(y) : med.homogeneous.sigma_s;
     if (!(sigma_s > 0)) return;
     LightSample ls;
     if (!lights.sample(li, y, u1, u2, ls)) return;
     const double f = hg_eval(dot(ray.d, ls.wi), med.g());
     double Tr, dt;
     if (!(f > 0) || !tracker_.connect(y, m, ls.wi, ls.dist, Tr, dt, stats)) return;
-    const double weight = sigma_s * std::exp(-tau) * f * Tr / (p_sum * pmf * ls.pdf);
+    const double weight = sigma_s * T * f * Tr / (p_sum * pmf * ls.pdf);
     deposit(t + opl * t_factor + dt + L.pulse.offset_ps, L.pulse.sigma_ps(), beta * ls.Li * weight,
             acc, stats);
   };
   if (eq_ok) contribute(eq.sample(u_e));
-  if (lp_ok) contribute(lp.sample(win, u_l));
+  if (lp_ok) contribute(target.lp.sample(target.win, u_l));
 }
 
 }  // namespace femto

@@ -52,20 +52,29 @@ bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
   return all || decided || auto_connects(light, ray.o, ray.d, s_surf, sigma_t);
 }
 
+bool VolPathIntegrator::ConnectedSegment::mis_with_collisions(const Light& light) const {
+  return time_mis && lights_from_start(ray.o, ray.d, light.position);
+}
+
 VolPathIntegrator::ConnectedSegment VolPathIntegrator::plan_segment(const Medium& med,
-                                                                    const Ray& ray,
-                                                                    double s_surf) const {
+                                                                    const Ray& ray, double s_surf,
+                                                                    double t, double t_factor,
+                                                                    bool camera_segment) const {
   ConnectedSegment segment;
   if (med.connection == ConnectionSampling::Collision || point_lights_.empty() || !med.interacts())
     return segment;
   segment.ray = ray;
   segment.s_surf = s_surf;
+  segment.t = t;
+  segment.t_factor = t_factor;
   segment.all = med.connection != ConnectionSampling::Auto;
   if (segment.all) {
     segment.active = true;
     return segment;
   }
   segment.sigma_t = spread_sigma_t(med, ray.o);
+  segment.time_mis = camera_segment && med.strategy.kind == DistanceSampling::Mfp &&
+                     starved_segment(s_surf, kSpeedOfLight * (t_cut_ - t), segment.sigma_t);
   const LightSet& lights = scene_.lights();
   for (int li : point_lights_)
     if (auto_connects(lights.light(li), ray.o, ray.d, s_surf, segment.sigma_t)) {
@@ -73,36 +82,56 @@ VolPathIntegrator::ConnectedSegment VolPathIntegrator::plan_segment(const Medium
       break;
     }
   segment.decided = point_lights_.size() == 1;
+  if (segment.decided && !segment.active) {
+    const Light& L = lights.light(point_lights_[0]);
+    if (segment.mis_with_collisions(L))
+      segment.lp_target = line_to_point_target(med, segment, L, true);
+  }
   return segment;
 }
 
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
                                                const RGB& beta, double t, const DirectionMix* mix,
-                                               const ConnectedSegment& segment, Rng& rng,
-                                               PixelAccumulator& acc, PathStats& stats) const {
+                                               const ConnectedSegment& segment, double s_seg,
+                                               Rng& rng, PixelAccumulator& acc,
+                                               PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
   const double u1 = rng.uniform(), u2 = rng.uniform();
   LightSample ls;
   if (li < 0 || beta.is_black()) return;
-  if (is_point_like(lights.light(li)) && segment.covers(lights.light(li)))
-    return;  // estimate_segment's share
+  const Light& L = lights.light(li);
+  double w_seg = 1.0;  // the collisions' balance-heuristic weight on a time_mis segment
+  if (is_point_like(L)) {
+    if (segment.covers(L)) return;  // estimate_segment's share
+    if (s_seg >= 0 && segment.mis_with_collisions(L)) {
+      const LineToPointTarget target =
+          segment.lp_target
+              ? *segment.lp_target
+              : line_to_point_target(scene_.media()[static_cast<size_t>(m)], segment, L, true);
+      const double p_lp =
+          target.valid && s_seg < target.s_end ? target.lp.pdf(target.win, s_seg) : 0.0;
+      if (p_lp > 0) {
+        const double p_c =
+            collision_density(scene_.media()[static_cast<size_t>(m)], m, segment.ray, s_seg);
+        w_seg = p_c / (p_c + p_lp);
+      }
+    }
+  }
   if (!lights.sample(li, x, u1, u2, ls)) return;
   const double f = hg_eval(dot(d, ls.wi), g);
   double Tr, dt;
   if (!(f > 0) || !tracker_.connect(x, m, ls.wi, ls.dist, Tr, dt, stats)) return;
   const double p_dir = ls.is_delta ? 0.0 : mix ? direction_pdf(*mix, x, d, g, ls.wi) : f;
-  const double w = ls.is_delta ? 1.0 : power_heuristic(pmf * ls.pdf, p_dir);
-  const Light& L = lights.light(li);
+  const double w = ls.is_delta ? w_seg : power_heuristic(pmf * ls.pdf, p_dir);
   deposit(t + dt + L.pulse.offset_ps, L.pulse.sigma_ps(),
           beta * ls.Li * (f * Tr * w / (pmf * ls.pdf)), acc, stats);
 }
 
 void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit,
                                                 const Frame& frame, const Vec3& wo, bool wo_outside,
-                                                int m_wo,
-                                                const RGB& beta, double t, Rng& rng,
+                                                int m_wo, const RGB& beta, double t, Rng& rng,
                                                 PixelAccumulator& acc, PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
@@ -197,9 +226,10 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
                               : 0.0;
       const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next, q_tu);
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
-      const ConnectedSegment segment = plan_segment(med, ray, s_surf);
-      if (segment.active && depth < max_depth_ && !past_xc)
-        estimate_segment(med, m, segment, beta, t, t_dropped, rng, acc, stats);
+      const ConnectedSegment segment =
+          plan_segment(med, ray, s_surf, t, t_dropped, on_camera_segment);
+      if ((segment.active || segment.time_mis) && depth < max_depth_ && !past_xc)
+        estimate_segment(med, m, segment, beta, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every
       // strategy's MIS weight at this segment's vertices sees the same r_aux.
       const bool angular = med.direction == DirectionSampling::Angular && !point_lights_.empty() &&
@@ -218,7 +248,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
             angular ? direction_mix(med, x2, t2, u_next, depth + 1) : DirectionMix{};
         estimate_direct_medium(x2, m, ray.d, med.g(),
                                beta * (MediumTracker::albedo_at(med, x2) * ms.extra_nee_weight), t2,
-                               angular ? &mix2 : nullptr, segment, rng, acc, stats);
+                               angular ? &mix2 : nullptr, segment, -1.0, rng, acc, stats);
       }
       const DistanceEvent& ev = ms.main;
       if (!ev.collided && !found) break;  // escaped to infinity
@@ -243,7 +273,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
         beta *= MediumTracker::albedo_at(med, x);
         if (beta.is_black()) break;
         estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t,
-                               angular ? &mix_main : nullptr, segment, rng, acc, stats);
+                               angular ? &mix_main : nullptr, segment, ev.s, rng, acc, stats);
         Vec3 wi;
         beta *=
             sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone

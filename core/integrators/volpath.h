@@ -6,6 +6,7 @@
 // deposited into the pixel's time bins. With a photon pass (core/integrators/photon_map.h) the
 // tracer gathers caustic photons at diffuse surfaces and leaves those paths to them.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/bsdf/bsdf.h"
@@ -14,6 +15,7 @@
 #include "core/scene.h"
 #include "core/temporal_filter.h"
 #include "core/transport/tracker.h"
+#include "samplers/line_to_point.h"
 #include "samplers/medium_distance.h"
 
 namespace femto {
@@ -64,31 +66,56 @@ class VolPathIntegrator {
   /// Samples the next direction; returns f / pdf (1 for phase sampling alone) and the pdf.
   double sample_direction(const DirectionMix& mix, const Vec3& x, const Vec3& d, double g, Rng& rng,
                           Vec3& w, double& pdf) const;
+  /// A segment's line-to-point connection to light L: the sampler, its window and the end of the
+  /// reachable part. The connection and the collisions' MIS weights both use it.
+  struct LineToPointTarget {
+    bool valid = false;  ///< some s in [0, s_end) connects inside the window
+    double s_end = 0;    ///< beyond it no connection can reach the window, mm
+    LineToPointSampler lp;
+    LineToPointSampler::Window win;
+  };
   /// The segment a medium vertex lies on, as far as segment connections are concerned: which
   /// point and spot lights estimate_segment has already gathered along it.
   struct ConnectedSegment {
-    bool active = false;  ///< some point or spot light is gathered by connections on this segment
-    bool all = false;     ///< every point light (an explicit strategy), else connection_choice.h
+    bool active = false;   ///< some point or spot light is gathered by connections on this segment
+    bool all = false;      ///< every point light (an explicit strategy), else connection_choice.h
     bool decided = false;  ///< auto with a single point light: active says it all
+    /// auto on a camera segment whose window spans many mean free paths: point lights that
+    /// `covers` leaves to the collisions also get one line-to-point connection, and the two
+    /// strategies share that light by the balance heuristic (connection_choice.h).
+    bool time_mis = false;
     Ray ray;
     double s_surf = 0, sigma_t = 0;
+    double t = 0, t_factor = 0;  ///< path time at ray.o (ps) and the OPL -> time factor
     bool covers(const Light& light) const;
+    /// time_mis for this light: the light lies behind the segment's start (lights_from_start).
+    bool mis_with_collisions(const Light& light) const;
+    /// With a single point light that mis_with_collisions: its target, made once per segment.
+    std::optional<LineToPointTarget> lp_target;
   };
   /// The segment's connection plan, decided once per segment (and without random draws, so a
-  /// segment that connects nothing costs a few flops).
-  ConnectedSegment plan_segment(const Medium& med, const Ray& ray, double s_surf) const;
+  /// segment that connects nothing costs a few flops). t, t_factor: as for estimate_segment.
+  ConnectedSegment plan_segment(const Medium& med, const Ray& ray, double s_surf, double t,
+                                double t_factor, bool camera_segment) const;
+  /// A segment's line-to-point connection to light L (narrow: with its window).
+  LineToPointTarget line_to_point_target(const Medium& med, const ConnectedSegment& segment,
+                                         const Light& L, bool narrow_window) const;
+  /// Density of the segment's mean-free-path collisions at distance s (the balance heuristic's
+  /// other strategy on time_mis segments).
+  double collision_density(const Medium& med, int m, const Ray& ray, double s) const;
   /// Next-event estimation from a medium point x reached along direction d with throughput beta.
   /// `mix` (may be null) gives the direction density for MIS with area lights; point and spot
-  /// lights that `segment` covers are left to estimate_segment.
+  /// lights that `segment` covers are left to estimate_segment. s_seg: x's distance along the
+  /// segment when x is its mean-free-path collision (else < 0), for time_mis weights.
   void estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g, const RGB& beta,
                               double t, const DirectionMix* mix, const ConnectedSegment& segment,
-                              Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
-  /// Direct light from a point or spot light scattered anywhere on [0, s_surf) of `ray` in
-  /// medium m (equiangular, line-to-point, or both by MIS). t_factor converts optical path
-  /// length to time (0 on the camera segment in unwarp mode).
+                              double s_seg, Rng& rng, PixelAccumulator& acc,
+                              PathStats& stats) const;
+  /// Direct light from a point or spot light scattered anywhere on [0, s_surf) of the segment's
+  /// ray in medium m (equiangular, line-to-point, or both by MIS; on time_mis segments also
+  /// line-to-point with the collisions by MIS).
   void estimate_segment(const Medium& med, int m, const ConnectedSegment& segment, const RGB& beta,
-                        double t, double t_factor, Rng& rng, PixelAccumulator& acc,
-                        PathStats& stats) const;
+                        Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
   void deposit(double t_ps, double sigma_ps, const RGB& value, PixelAccumulator& acc,
                PathStats& stats) const;
   /// Next-event estimation at a surface vertex with a non-delta BSDF (local frame z = ng); m_wo
