@@ -6,6 +6,7 @@
 
 #include "core/bsdf/fresnel.h"
 #include "core/sampling.h"
+#include "core/sincos_2pi.h"
 #include "core/transport/voxel_space.h"
 #include "media/grid_medium.h"  // clamped_floor
 
@@ -14,7 +15,7 @@ namespace femto::tissue {
 namespace {
 double standard_normal(Rng& rng) {
   const double u1 = rng.uniform(), u2 = rng.uniform();
-  return std::sqrt(-2.0 * std::log1p(-u1)) * std::cos(2.0 * kPi * u2);
+  return std::sqrt(-2.0 * std::log1p(-u1)) * sincos_2pi(u2).cos;
 }
 }  // namespace
 
@@ -56,12 +57,13 @@ bool launch(const Setup& s, const Space& space, const Emitter& emitter, Rng& rng
   p.x = src.position;
   p.d = src.direction;
   if (src.type == Source::Type::Gaussian || src.type == Source::Type::Disk) {
-    const double u = rng.uniform(), phi = 2.0 * kPi * rng.uniform();
+    const double u = rng.uniform();
+    const SinCos phi = sincos_2pi(rng.uniform());  // exact at quarter turns, as elsewhere
     // Gaussian: intensity exp(-2 r^2 / w^2) (w: 1/e^2 radius); disk: uniform in area.
     const double r = src.type == Source::Type::Gaussian
                          ? src.waist * std::sqrt(-0.5 * std::log1p(-u))
                          : src.radius * std::sqrt(u);
-    p.x += Frame(src.direction).to_world({r * std::cos(phi), r * std::sin(phi), 0.0});
+    p.x += Frame(src.direction).to_world({r * phi.cos, r * phi.sin, 0.0});
   } else if (src.type == Source::Type::Isotropic) {
     const double u1 = rng.uniform(), u2 = rng.uniform();
     p.d = sample_uniform_sphere(u1, u2);
