@@ -168,18 +168,132 @@ RenderResult run(const Scene& scene, IntegratorKind kind, int64_t work, const Op
 int64_t work_for_budget(const Scene& scene, IntegratorKind kind, const Options& o) {
   const int64_t pixels = static_cast<int64_t>(scene.camera().width()) * scene.camera().height();
   // One pass of all beams is slow in this large, thin fog: probe with one.
-  const int64_t probe =
-      kind == IntegratorKind::Light ? 4 * pixels : kind == IntegratorKind::Beams ? 1 : 4;
+  const int64_t probe = kind == IntegratorKind::Light   ? 4 * pixels
+                        : kind == IntegratorKind::Beams ? 1
+                                                        : 4;
   const double t0 = now_s();
   run(scene, kind, probe, o, 999);
   const double dt = now_s() - t0;
   return std::max<int64_t>(1, static_cast<int64_t>(static_cast<double>(probe) * o.seconds / dt));
 }
 
+/// Sums of a film (or reference) over blocks of B x B pixels and G bins, channels kept: the
+/// tissue example's light is a small bright spot and a dim glow, and a per-pixel, per-bin
+/// reference would need hours; the blocks are what is compared there.
+Reference blocks(const std::vector<double>& steady, const std::vector<double>& transient, int W,
+                 int H, int T, int B, int G) {
+  const int bw = (W + B - 1) / B, bh = (H + B - 1) / B, bt = (T + G - 1) / G;
+  Reference r;
+  r.bins = bt;
+  r.steady.assign(static_cast<size_t>(bw * bh) * 3, 0.0);
+  r.transient.assign(static_cast<size_t>(bw * bh * bt) * 3, 0.0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
+      const size_t q = static_cast<size_t>((y / B) * bw + x / B);
+      for (int c = 0; c < 3; ++c) {
+        r.steady[q * 3 + static_cast<size_t>(c)] += steady[p * 3 + static_cast<size_t>(c)];
+        for (int t = 0; t < T; ++t)
+          r.transient[(q * static_cast<size_t>(bt) + static_cast<size_t>(t / G)) * 3 +
+                      static_cast<size_t>(c)] +=
+              transient[(p * static_cast<size_t>(T) + static_cast<size_t>(t)) * 3 +
+                        static_cast<size_t>(c)];
+      }
+    }
+  return r;
+}
+
+Reference blocks(const TransientFilm& f, int B, int G) {
+  const size_t ns = static_cast<size_t>(f.width()) * static_cast<size_t>(f.height()) * 3;
+  const std::vector<double> s(f.steady(), f.steady() + ns);
+  const std::vector<double> t(f.transient(), f.transient() + ns * static_cast<size_t>(f.bins()));
+  return blocks(s, t, f.width(), f.height(), f.bins(), B, G);
+}
+
+std::vector<float> as_float(const std::vector<double>& v) {
+  return {v.begin(), v.end()};
+}
+
+/// A scene file whose light camera paths cannot reach (the tissue example: a laser behind a
+/// refracting surface): hybrid and beams against a long beams reference (two halves), over
+/// blocks of 8 x 8 pixels and 4 bins whose reference is above 1% of the brightest block.
+int run_scene_file(const std::string& file, const Options& o, int ref_passes, int width,
+                   int height) {
+  SceneDesc desc;
+  try {
+    desc = load_scene_file(file);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "femto-bench-caustics: %s\n", e.what());
+    return 2;
+  }
+  if (width > 0) desc.camera.width = width, desc.camera.height = height;
+  const Scene scene(desc);
+  constexpr int kBlock = 8, kGroup = 4;
+  std::printf(
+      "scene %s at %d x %d; reference: beams, two halves of %d passes; blocks of %d x %d "
+      "pixels and %d bins\n",
+      file.c_str(), desc.camera.width, desc.camera.height, ref_passes, kBlock, kBlock, kGroup);
+  std::fflush(stdout);
+  double t0 = now_s();
+  const Reference a =
+      blocks(run(scene, IntegratorKind::Beams, ref_passes, o, o.seed + 100).film, kBlock, kGroup);
+  const Reference b =
+      blocks(run(scene, IntegratorKind::Beams, ref_passes, o, o.seed + 101).film, kBlock, kGroup);
+  Reference ref = a;
+  for (size_t i = 0; i < ref.steady.size(); ++i) ref.steady[i] = 0.5 * (a.steady[i] + b.steady[i]);
+  for (size_t i = 0; i < ref.transient.size(); ++i)
+    ref.transient[i] = 0.5 * (a.transient[i] + b.transient[i]);
+  const size_t n_blocks = ref.steady.size() / 3;
+  double peak = 0;
+  for (size_t q = 0; q < n_blocks; ++q)
+    peak = std::max(peak, ref.steady[3 * q] + ref.steady[3 * q + 1] + ref.steady[3 * q + 2]);
+  std::vector<int> lit;
+  for (size_t q = 0; q < n_blocks; ++q)
+    if (ref.steady[3 * q] + ref.steady[3 * q + 1] + ref.steady[3 * q + 2] > 0.01 * peak)
+      lit.push_back(static_cast<int>(q));
+  const Errors e_ref = errors(as_float(a.steady).data(), as_float(a.transient).data(), b, lit);
+  std::printf(
+      "reference took %.0f s; %zu of %zu blocks above 1%% of the brightest; its own "
+      "relative RMSE: steady %.4f, transient %.4f\n",
+      now_s() - t0, lit.size(), n_blocks, e_ref.steady / 2, e_ref.transient / 2);
+  std::printf("\n%-12s %8s %9s %13s %16s %28s\n", "estimator", "passes", "seconds", "steady rRMSE",
+              "transient rRMSE", "equal-time steady / transient");
+  double base_s = 0, base_t = 0;
+  for (const IntegratorKind kind :
+       {IntegratorKind::Hybrid, IntegratorKind::Beams, IntegratorKind::Path}) {
+    const int64_t work = work_for_budget(scene, kind, o);
+    t0 = now_s();
+    const RenderResult r = run(scene, kind, work, o, o.seed);
+    const double secs = now_s() - t0;
+    const Reference got = blocks(r.film, kBlock, kGroup);
+    double total = 0;
+    for (double v : got.steady) total += v;
+    if (kind == IntegratorKind::Path && !(total > 0)) {
+      std::printf("%-12s %8lld %9.1f   estimate zero: camera paths cannot reach the light\n",
+                  "path", static_cast<long long>(work), secs);
+      continue;
+    }
+    const Errors e = errors(as_float(got.steady).data(), as_float(got.transient).data(), ref, lit);
+    const double scale = std::sqrt(secs / o.seconds);
+    if (kind == IntegratorKind::Hybrid) base_s = e.steady * scale, base_t = e.transient * scale;
+    const char* name = kind == IntegratorKind::Hybrid  ? "hybrid"
+                       : kind == IntegratorKind::Beams ? "beams"
+                                                       : "path";
+    std::printf("%-12s %8lld %9.1f %13.4f %16.4f %10.4f / %.4f (%.1fx / %.1fx)\n", name,
+                static_cast<long long>(work), secs, e.steady, e.transient, e.steady * scale,
+                e.transient * scale, base_s / (e.steady * scale), base_t / (e.transient * scale));
+    std::fflush(stdout);
+  }
+  std::printf("\nratios against the hybrid\n");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   Options o;
+  std::string scene_file;
+  int ref_passes = 100, width = 0, height = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -197,22 +311,40 @@ int main(int argc, char** argv) {
       o.threads = std::atoi(next().c_str());
     else if (a == "--seed")
       o.seed = std::strtoull(next().c_str(), nullptr, 10);
-    else if (a == "--crop") {
+    else if (a == "--scene")
+      scene_file = next();
+    else if (a == "--ref-passes")
+      ref_passes = std::atoi(next().c_str());
+    else if (a == "--size") {
+      if (std::sscanf(next().c_str(), "%d,%d", &width, &height) != 2 || width < 1 || height < 1) {
+        std::fprintf(stderr, "femto-bench-caustics: --size expects W,H (pixels)\n");
+        return 2;
+      }
+    } else if (a == "--crop") {
       if (std::sscanf(next().c_str(), "%d,%d,%d,%d", &o.x0, &o.y0, &o.x1, &o.y1) != 4) {
         std::fprintf(stderr, "femto-bench-caustics: --crop expects X0,Y0,X1,Y1\n");
         return 2;
       }
-    }
-    else if (a == "--help") {
+    } else if (a == "--help") {
       std::printf(
           "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S] "
-          "[--crop X0,Y0,X1,Y1]\n  default crop: the caustic on the floor; --crop 100,88,156,128: the fog "
-          "under the sphere\n");
+          "[--crop X0,Y0,X1,Y1]\n  default crop: the caustic on the floor; --crop 100,88,156,128: "
+          "the fog "
+          "under the sphere\n"
+          "       femto-bench-caustics --scene FILE [--ref-passes N] [--size W,H] [--seconds S] "
+          "[--threads N]\n"
+          "  a scene whose light camera paths cannot reach (data/scenes/tissue_laser.json): "
+          "hybrid, beams and camera paths against a beams reference of 2 x N passes\n");
       return 0;
     } else {
       std::fprintf(stderr, "femto-bench-caustics: unknown option %s\n", a.c_str());
       return 2;
     }
+  }
+  if (!scene_file.empty()) {
+    std::printf("femto-bench-caustics: CPU %s, %d threads, %.0f s per estimator\n",
+                cpu_model().c_str(), o.threads, o.seconds);
+    return run_scene_file(scene_file, o, ref_passes, width, height);
   }
   std::printf(
       "femto-bench-caustics: CPU %s, %d threads, %.0f s per estimator, references of %.3g light "
@@ -226,8 +358,8 @@ int main(int argc, char** argv) {
   const Scene sphere(sphere_emitter_scene(spot_desc, 2.0));
   const Scene housed(housed_emitter_scene(spot_desc, 2.0));
   const std::vector<int> px = crop_pixels(spot, o, *glass);
-  std::printf("crop x [%d, %d) y [%d, %d): %zu pixels that see no glass\n", o.x0, o.x1, o.y0,
-              o.y1, px.size());
+  std::printf("crop x [%d, %d) y [%d, %d): %zu pixels that see no glass\n", o.x0, o.x1, o.y0, o.y1,
+              px.size());
 
   std::printf("references (light tracing, two halves each)...\n");
   std::fflush(stdout);

@@ -52,6 +52,21 @@ IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, s
     why = "auto: delta lights and non-diffuse surfaces, so caustics come from photons";
     return IntegratorKind::Photons;
   }
+  // Every surface specular (glass, mirrors, index-matched boundaries): no photon has a surface to
+  // land on, and camera paths meet the media before any non-specular surface, so beams gather
+  // all of the medium light; the hybrid would leave most of it to camera paths scattering their
+  // way to the light's first segments (4-11x worse at equal time on such scenes,
+  // docs/PERFORMANCE.md).
+  const bool all_specular =
+      std::all_of(scene.shapes.begin(), scene.shapes.end(), [](const ShapeDesc& s) {
+        return s.material.type == MaterialDesc::Type::None || s.material.is_specular();
+      });
+  if (all_specular) {
+    why =
+        "auto: delta lights and a scattering medium behind specular surfaces only, so photon "
+        "beams gather all light scattered in the media";
+    return IntegratorKind::Beams;
+  }
   why =
       "auto: delta lights, non-diffuse surfaces and a scattering medium, so caustics come from "
       "photons on "
