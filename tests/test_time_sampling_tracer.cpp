@@ -62,6 +62,20 @@ int check_agreement(const BinStats& a, const BinStats& b, const std::string& wha
   return compared;
 }
 
+/// Bin i of single-scattering renders against its exact value: within 4 standard errors.
+struct BinCheck {
+  MeanSE m;
+  double expected;
+};
+BinCheck check_bin(const std::vector<TransientFilm>& films, const SingleScatterSetup& p, int i,
+                   const char* name) {
+  const MeanSE m = bin_mean_se(films, i);
+  const double expected = p.bin(i);
+  INFO(name << " bin " << i << ": " << m.mean << " +- " << m.se << " expected " << expected);
+  CHECK(std::abs(m.mean - expected) <= 4.0 * m.se + 1e-9 * expected);
+  return {m, expected};
+}
+
 }  // namespace
 
 // Catches: a wrong equiangular or line-to-point pdf in the tracer, a vertex time or
@@ -82,11 +96,7 @@ TEST_CASE("segment connections match the single-scattering answer bin by bin", "
         render_batches(d, c == ConnectionSampling::Auto ? 4000 : 2000, 16, /*max_depth=*/1);
     int checked = 0;
     for (int i = 0; i < p.axis.bins; ++i) {
-      const MeanSE m = bin_mean_se(films, i);
-      const double expected = p.bin(i);
-      INFO(name_of(c) << " bin " << i << ": " << m.mean << " +- " << m.se << " expected "
-                      << expected);
-      CHECK(std::abs(m.mean - expected) <= 4.0 * m.se + 1e-9 * expected);
+      const auto [m, expected] = check_bin(films, p, i, name_of(c));
       if (expected > 0) {
         CHECK(m.se < 0.1 * expected);  // enough resolving power to see a missing term
         ++checked;
@@ -241,11 +251,7 @@ TEST_CASE("auto's camera-segment MIS is unbiased and pays in the late frames", "
     const bool is_auto = c == ConnectionSampling::Auto;
     const auto films = render_batches(d, is_auto ? 1000 : 4000, 16, /*max_depth=*/1);
     for (int i = 0; i < p.axis.bins; ++i) {
-      const MeanSE m = bin_mean_se(films, i);
-      const double expected = p.bin(i);
-      INFO(name_of(c) << " bin " << i << ": " << m.mean << " +- " << m.se << " expected "
-                      << expected);
-      CHECK(std::abs(m.mean - expected) <= 4.0 * m.se + 1e-9 * expected);
+      const auto [m, expected] = check_bin(films, p, i, name_of(c));
       // Relative standard errors at 1000 samples per batch.
       (is_auto ? se_auto : se_collision).push_back(m.se / expected * (is_auto ? 1.0 : 2.0));
     }
