@@ -1,8 +1,8 @@
 #pragma once
 // Single scattering along one camera ray: the ray x(s) = (0, 0, s) in a homogeneous medium, lit
-// by a point light at (0, h, 0), seen in camera time t(s) = eta (s + r(s)) / c with
-// r = sqrt(s^2 + h^2). Its time-resolved radiance is a 1-D integral over s. Shared by the tests
-// and the benchmarks that need an exact time-resolved answer.
+// by a point light at (0, h, z0), seen in camera time t(s) = eta (s + r(s)) / c with
+// r = sqrt((s - z0)^2 + h^2). Its time-resolved radiance is a 1-D integral over s. Shared by the
+// tests and the benchmarks that need an exact time-resolved answer.
 #include <algorithm>
 #include <cmath>
 
@@ -16,22 +16,27 @@ namespace femto::test {
 
 struct SingleScatterSetup {
   double sigma_a = 0.01, sigma_s = 0.05, g = 0.4, eta = 1.2, h = 30.0, I = 1000.0;
+  double z0 = 0.0;  ///< the light's position along the ray (> 0: ahead of the camera)
   TimeAxis axis;
 
   double sigma_t() const { return sigma_a + sigma_s; }
-  double onset_ps() const { return eta * h / kSpeedOfLight; }  ///< first light: the vertex at s = 0
+  /// First light: the vertex at s = 0.
+  double onset_ps() const { return eta * std::sqrt(z0 * z0 + h * h) / kSpeedOfLight; }
   /// Radiance per unit distance contributed by the vertex at s.
   double density(double s) const {
     const double st = sigma_t();
-    const double r = std::sqrt(s * s + h * h);
-    const double cos_t = -s / r;  // light travels (x - L) / r, then -z towards the camera
+    const double r = std::sqrt((s - z0) * (s - z0) + h * h);
+    const double cos_t = -(s - z0) / r;  // light travels (x - L) / r, then -z towards the camera
     return sigma_s * std::exp(-st * s) * hg_eval(cos_t, g) * I * std::exp(-st * r) / (r * r);
   }
-  double time_of(double s) const { return eta * (s + std::sqrt(s * s + h * h)) / kSpeedOfLight; }
-  /// Inverse of time_of: s + sqrt(s^2 + h^2) = tau  <=>  s = (tau^2 - h^2) / (2 tau).
+  double time_of(double s) const {
+    return eta * (s + std::sqrt((s - z0) * (s - z0) + h * h)) / kSpeedOfLight;
+  }
+  /// Inverse of time_of: s + sqrt((s - z0)^2 + h^2) = tau  <=>
+  /// s = (tau^2 - z0^2 - h^2) / (2 (tau - z0)), for tau >= sqrt(z0^2 + h^2) (the onset).
   double s_of_time(double t) const {
-    const double tau = std::max(t * kSpeedOfLight / eta, h);
-    return (tau * tau - h * h) / (2.0 * tau);
+    const double tau = std::max(t * kSpeedOfLight / eta, std::sqrt(z0 * z0 + h * h));
+    return (tau * tau - z0 * z0 - h * h) / (2.0 * (tau - z0));
   }
   /// Integral of density over [s0, s1] to ~1e-11 relative: pieces of at most 4 mm so the adaptive
   /// rule sees the 1/r^2 peak, each with a tolerance relative to its own size (late bins are
@@ -61,7 +66,7 @@ struct SingleScatterSetup {
     d.media.push_back(medium("m", sigma_a, sigma_s, g, eta));
     d.global_medium = 0;
     LightDesc l;
-    l.position = {0, h, 0};
+    l.position = {0, h, z0};
     l.intensity = RGB(I);
     d.lights.push_back(l);
     return d;

@@ -266,3 +266,34 @@ TEST_CASE("auto's camera-segment MIS is unbiased and pays in the late frames", "
   INFO("late relative variance, auto " << v_auto << ", collisions " << v_collision);
   CHECK(v_auto < 0.25 * v_collision);
 }
+
+// Catches: with several point lights (no single light's plan made once per segment), a light
+// gathered twice or by neither: one light level with the camera (the camera segment's MIS of
+// collisions and line-to-point) and one ahead of it beside the ray (collisions alone) add their
+// own single scattering, bin by bin.
+TEST_CASE("auto's camera-segment MIS with two point lights", "[time-sampling]") {
+  SingleScatterSetup p;
+  p.axis.t_start_ps = 100;
+  p.axis.bin_width_ps = 20;
+  p.axis.bins = 20;
+  SingleScatterSetup ahead = p;
+  ahead.z0 = 40;
+  SceneDesc d = p.scene();
+  d.media[0].connection = ConnectionSampling::Auto;
+  LightDesc second = d.lights.front();
+  second.position = {0, -ahead.h, ahead.z0};  // the mirror image: the same single scattering
+  d.lights.push_back(second);
+  const auto films = render_batches(d, 8000, 16, /*max_depth=*/1);
+  int checked = 0;
+  for (int i = 0; i < p.axis.bins; ++i) {
+    const MeanSE m = bin_mean_se(films, i);
+    const double expected = p.bin(i) + ahead.bin(i);
+    INFO("bin " << i << ": " << m.mean << " +- " << m.se << " expected " << expected);
+    CHECK(std::abs(m.mean - expected) <= 4.0 * m.se + 1e-9 * expected);
+    if (expected > 0) {
+      CHECK(m.se < 0.1 * expected);
+      ++checked;
+    }
+  }
+  CHECK(checked >= 15);
+}
