@@ -128,8 +128,10 @@ Reference mean_of(const TransientFilm& a, const TransientFilm& b) {
   return r;
 }
 
-Errors errors(const float* steady, const float* transient, const Reference& ref,
-              const std::vector<int>& px, double scale = 1.0) {
+/// Relative errors of a film (float) or a block sum (double) against ref.
+template <class V>
+Errors errors(const V* steady, const V* transient, const Reference& ref, const std::vector<int>& px,
+              double scale = 1.0) {
   const int T = ref.bins;
   double se_s = 0, se_t = 0, m_s = 0, m_t = 0;
   for (int p : px)
@@ -210,8 +212,13 @@ Reference blocks(const TransientFilm& f, int B, int G) {
   return blocks(s, t, f.width(), f.height(), f.bins(), B, G);
 }
 
-std::vector<float> as_float(const std::vector<double>& v) {
-  return {v.begin(), v.end()};
+/// The mean of two references of the same layout.
+Reference average(const Reference& a, const Reference& b) {
+  Reference r = a;
+  for (size_t i = 0; i < r.steady.size(); ++i) r.steady[i] = 0.5 * (a.steady[i] + b.steady[i]);
+  for (size_t i = 0; i < r.transient.size(); ++i)
+    r.transient[i] = 0.5 * (a.transient[i] + b.transient[i]);
+  return r;
 }
 
 /// A scene file whose light camera paths cannot reach (the tissue example: a laser behind a
@@ -239,10 +246,7 @@ int run_scene_file(const std::string& file, const Options& o, int ref_passes, in
       blocks(run(scene, IntegratorKind::Beams, ref_passes, o, o.seed + 100).film, kBlock, kGroup);
   const Reference b =
       blocks(run(scene, IntegratorKind::Beams, ref_passes, o, o.seed + 101).film, kBlock, kGroup);
-  Reference ref = a;
-  for (size_t i = 0; i < ref.steady.size(); ++i) ref.steady[i] = 0.5 * (a.steady[i] + b.steady[i]);
-  for (size_t i = 0; i < ref.transient.size(); ++i)
-    ref.transient[i] = 0.5 * (a.transient[i] + b.transient[i]);
+  const Reference ref = average(a, b);
   const size_t n_blocks = ref.steady.size() / 3;
   double peak = 0;
   for (size_t q = 0; q < n_blocks; ++q)
@@ -251,7 +255,7 @@ int run_scene_file(const std::string& file, const Options& o, int ref_passes, in
   for (size_t q = 0; q < n_blocks; ++q)
     if (ref.steady[3 * q] + ref.steady[3 * q + 1] + ref.steady[3 * q + 2] > 0.01 * peak)
       lit.push_back(static_cast<int>(q));
-  const Errors e_ref = errors(as_float(a.steady).data(), as_float(a.transient).data(), b, lit);
+  const Errors e_ref = errors(a.steady.data(), a.transient.data(), b, lit);
   std::printf(
       "reference took %.0f s; %zu of %zu blocks above 1%% of the brightest; its own "
       "relative RMSE: steady %.4f, transient %.4f\n",
@@ -273,7 +277,7 @@ int run_scene_file(const std::string& file, const Options& o, int ref_passes, in
                   "path", static_cast<long long>(work), secs);
       continue;
     }
-    const Errors e = errors(as_float(got.steady).data(), as_float(got.transient).data(), ref, lit);
+    const Errors e = errors(got.steady.data(), got.transient.data(), ref, lit);
     const double scale = std::sqrt(secs / o.seconds);
     if (kind == IntegratorKind::Hybrid) base_s = e.steady * scale, base_t = e.transient * scale;
     const char* name = kind == IntegratorKind::Hybrid  ? "hybrid"

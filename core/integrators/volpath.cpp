@@ -106,15 +106,13 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
   if (is_point_like(L)) {
     if (segment.covers(L)) return;  // estimate_segment's share
     if (s_seg >= 0 && segment.mis_with_collisions(L)) {
+      const Medium& med = scene_.media()[static_cast<size_t>(m)];
       const LineToPointTarget target =
-          segment.lp_target
-              ? *segment.lp_target
-              : line_to_point_target(scene_.media()[static_cast<size_t>(m)], segment, L, true);
+          segment.lp_target ? *segment.lp_target : line_to_point_target(med, segment, L, true);
       const double p_lp =
           target.valid && s_seg < target.s_end ? target.lp.pdf(target.win, s_seg) : 0.0;
       if (p_lp > 0) {
-        const double p_c =
-            collision_density(scene_.media()[static_cast<size_t>(m)], m, segment.ray, s_seg);
+        const double p_c = collision_density(med, m, segment.ray, s_seg);
         w_seg = p_c / (p_c + p_lp);
       }
     }
