@@ -53,6 +53,7 @@ class Tally {
     h_ = fg.spacing();
     cells_ = layout_.slots;
     plane_tolerance_ = 1e-6 * s.volume.voxel;
+    queue_.reserve(kQueue);
   }
   /// A chunk of `photons` photons starts: their partial paths are 0 and no record is kept.
   void start_chunk(ChunkSums& out, size_t photons) {
@@ -92,8 +93,12 @@ class Tally {
 
   void alive(const Photon& p) { out_->balance.alive += p.w; }
   void end() { flush(); }
-  /// The chunk's detected-photon records in photon order (they were made gate by gate).
-  void end_chunk() { sort_records(out_->records, record_photon_); }
+  /// The chunk's detected-photon records in photon order (they were made gate by gate); the
+  /// deposits still queued go into the sums.
+  void end_chunk() {
+    drain();
+    sort_records(out_->records, record_photon_);
+  }
   /// Where the walk should record the voxel faces of its steps (nullptr: not needed).
   VoxelCrossings* crossings() { return same_grid_ ? &crossings_ : nullptr; }
 
@@ -123,9 +128,27 @@ class Tally {
     pending_value_ += x;
   }
   void flush() {
-    if (pending_ != kNone) sums_.fluence[pending_] += fixed(pending_value_);
+    if (pending_ != kNone) {
+      queue_.push_back({pending_, fixed(pending_value_)});
+      if (queue_.size() == kQueue) drain();
+    }
     pending_ = kNone;
     pending_value_ = 0;
+  }
+  // The queued deposits into the sums, each prefetched kAhead deposits before its add: most
+  // sums are cache misses, and a loop of independent adds keeps many of them in flight (the walk
+  // would wait for each one).
+  void drain() {
+    constexpr size_t kAhead = 32;
+    uint64_t* sums = sums_.fluence.data();
+    const Deposit* q = queue_.data();
+    const size_t n = queue_.size();
+    for (size_t i = 0; i < std::min(n, kAhead); ++i) __builtin_prefetch(sums + q[i].index, 1);
+    for (size_t i = 0; i < n; ++i) {
+      if (i + kAhead < n) __builtin_prefetch(sums + q[i + kAhead].index, 1);
+      sums[q[i].index] += q[i].value;
+    }
+    queue_.clear();
   }
 
   // Adds the weighted track length of seg over tau in [a, b] (ps since its start) to cell `c`,
@@ -185,15 +208,6 @@ class Tally {
       const VoxelCrossings* vc = seg.crossings;
       if (vc && vc->complete()) {  // the faces the walk's march crossed: no second march
         const int step[3] = {seg.d[0] > 0 ? 1 : -1, seg.d[1] > 0 ? 1 : -1, seg.d[2] > 0 ? 1 : -1};
-        if (one_gate) {  // the sums are likely cache misses: ask for all of them at once
-          int c[3] = {cx, cy, cz};
-          const uint64_t* sums = sums_.fluence.data() + gate_offset;
-          __builtin_prefetch(sums + layout_.index(c[0], c[1], c[2]), 1);
-          for (int q = 0; q < vc->count; ++q) {
-            c[vc->axis[q]] += step[vc->axis[q]];
-            __builtin_prefetch(sums + layout_.index(c[0], c[1], c[2]), 1);
-          }
-        }
         for (int q = 0; q < vc->count; ++q) {
           piece(cx, cy, cz, vc->s[q]);
           const int a = vc->axis[q];
@@ -309,6 +323,12 @@ class Tally {
   size_t cells_ = 0;
   double plane_tolerance_ = 0;
   static constexpr size_t kNone = ~size_t{0};
+  struct Deposit {
+    size_t index;    // gate * cells_ + brick slot
+    uint64_t value;  // fixed point
+  };
+  static constexpr size_t kQueue = 4096;  // 64 KiB: stays in L2 between its fill and drain
+  std::vector<Deposit> queue_;
   size_t pending_ = kNone;
   double pending_value_ = 0;
   size_t labels_;

@@ -4,6 +4,7 @@
 // changes, or to the window end) and describes that piece as a Segment for the tallies. What the
 // space looks like is a template parameter (an unbounded homogeneous medium, or a labelled voxel
 // grid with Fresnel interfaces), so the hot loop has no virtual calls.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -13,6 +14,7 @@
 #include "core/constants.h"
 #include "core/rng.h"
 #include "core/transport/photon.h"
+#include "core/transport/safe_distance.h"
 #include "core/transport/tissue_volume.h"
 #include "media/phase_hg.h"
 
@@ -193,8 +195,10 @@ inline StepEvent enter(Photon& p, const int next[3], int label) {
 /// Snell's law, when `fresnel`; otherwise every face is index-matched (straight through).
 class LabelSpace {
  public:
-  LabelSpace(const LabelVolume& volume, bool fresnel) : vol_(volume), fresnel_(fresnel) {
+  LabelSpace(const LabelVolume& volume, bool fresnel)
+      : vol_(volume), fresnel_(fresnel), safe_(safe_distances(volume)) {
     for (const TissueOptics& o : volume.optics) optics_.push_back(WalkOptics::of(o));
+    margin_ = 1e-7 * volume.voxel;
   }
   const LabelVolume& volume() const { return vol_; }
   const WalkOptics& optics(int label) const { return optics_[static_cast<size_t>(label)]; }
@@ -209,6 +213,19 @@ class LabelSpace {
   /// null).
   double distance_to_interface(const Photon& p, double s_stop, int& axis, int end_cell[3],
                                VoxelCrossings* crossed) const {
+    // Far from other labels (most steps in a large tissue): no label to look up.
+    const int safe = safe_[vol_.index(p.cell[0], p.cell[1], p.cell[2])];
+    if (inside_safe_box(vol_, p.cell, safe, p.x + p.d * s_stop, margin_)) {
+      if (crossed)  // the faces for a tally; every neighbour has the label
+        return march_to_change(vol_, p, s_stop, axis, end_cell, crossed,
+                               [](ptrdiff_t) { return true; });
+      const Vec3 x1 = p.x + p.d * s_stop;
+      for (int a = 0; a < 3; ++a)
+        end_cell[a] =
+            std::clamp(static_cast<int>(std::floor((x1[a] - vol_.origin[a]) / vol_.voxel)),
+                       p.cell[a] - (safe - 1), p.cell[a] + (safe - 1));
+      return std::numeric_limits<double>::infinity();
+    }
     const uint16_t* labels = vol_.labels.data();
     const uint16_t label = static_cast<uint16_t>(p.label);
     return march_to_change(vol_, p, s_stop, axis, end_cell, crossed,
@@ -231,6 +248,8 @@ class LabelSpace {
   const LabelVolume& vol_;
   bool fresnel_;
   std::vector<WalkOptics> optics_;
+  std::vector<uint8_t> safe_;  // safe_distances(vol_)
+  double margin_ = 0;          // how far inside its safe box a step must end, mm
 };
 
 /// 1 - exp(-x) for x >= 0, to a relative error below 1e-13, cheaper than std::expm1: a series

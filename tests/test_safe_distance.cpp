@@ -1,0 +1,115 @@
+// The safe boxes of the labelled tissue walk (core/transport/safe_distance.h): the distance field
+// against a brute-force search, and the walk's distance to the next label change with the boxes
+// against a plain voxel march that looks up every label. Fixed seeds.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "core/rng.h"
+#include "core/transport/safe_distance.h"
+#include "core/transport/tissue_walk.h"
+
+using namespace femto;
+
+namespace {
+
+// A 24 x 20 x 16 grid of 0.5 mm voxels: label 1 with a block of label 2, a slab of label 3, a
+// few holes of label 0 and a scattering of single voxels of label 2.
+LabelVolume patchwork() {
+  LabelVolume v;
+  v.n[0] = 24, v.n[1] = 20, v.n[2] = 16;
+  v.voxel = 0.5;
+  v.origin = Vec3(-1.0, 2.0, 0.25);
+  v.labels.assign(v.cells(), 1);
+  for (int i = 0; i < v.n[0]; ++i)
+    for (int j = 0; j < v.n[1]; ++j)
+      for (int k = 0; k < v.n[2]; ++k) {
+        uint16_t l = 1;
+        if (i >= 14 && j >= 10 && k >= 9) l = 2;
+        if (k == 1) l = 3;
+        if ((i * 7 + j * 3 + k * 5) % 211 == 0) l = 0;
+        if ((i * 5 + j * 11 + k * 13) % 173 == 0) l = 2;
+        v.labels[v.index(i, j, k)] = l;
+      }
+  v.optics.assign(4, TissueOptics{0.01, 1.0, 0.0, 1.0});
+  return v;
+}
+
+// 1 + the chessboard distance to the nearest voxel of another label (or beyond the grid).
+int brute_safe(const LabelVolume& v, int i, int j, int k) {
+  const int label = v.labels[v.index(i, j, k)];
+  if (label == 0) return 0;
+  for (int r = 1;; ++r)
+    for (int a = i - r; a <= i + r; ++a)
+      for (int b = j - r; b <= j + r; ++b)
+        for (int c = k - r; c <= k + r; ++c)
+          if (v.label_at(a, b, c) != label) return std::min(r, 255);
+}
+
+}  // namespace
+
+TEST_CASE("safe distances are the chessboard distances to another label") {
+  // Catches an off-by-one in the transform (a box reaching into another label) or a pass that
+  // misses a direction of the 26-neighbourhood.
+  const LabelVolume v = patchwork();
+  const std::vector<uint8_t> d = safe_distances(v);
+  int above_two = 0;
+  for (int i = 0; i < v.n[0]; ++i)
+    for (int j = 0; j < v.n[1]; ++j)
+      for (int k = 0; k < v.n[2]; ++k) {
+        INFO("voxel " << i << " " << j << " " << k);
+        REQUIRE(d[v.index(i, j, k)] == brute_safe(v, i, j, k));
+        above_two += d[v.index(i, j, k)] > 2;
+      }
+  CHECK(above_two > 200);  // the test reaches the transform's propagation, not only its seeds
+}
+
+TEST_CASE("the walk's safe boxes give the distance to the next label of a plain march") {
+  // A wrong box would let a step run through a label change; a wrong end voxel would put the
+  // photon's cell out of step with its position.
+  const LabelVolume v = patchwork();
+  const LabelSpace space(v, false);
+  Rng rng(7, 3);
+  int skipped = 0, compared = 0;
+  for (int n = 0; n < 20000; ++n) {
+    Photon p;
+    for (int a = 0; a < 3; ++a) p.cell[a] = static_cast<int>(rng.uniform() * v.n[a]);
+    p.label = v.labels[v.index(p.cell[0], p.cell[1], p.cell[2])];
+    if (p.label == 0) continue;
+    for (int a = 0; a < 3; ++a) p.x[a] = v.origin[a] + (p.cell[a] + rng.uniform()) * v.voxel;
+    const double z = 1 - 2 * rng.uniform(), phi = 2 * kPi * rng.uniform();
+    const double r = std::sqrt(std::max(0.0, 1 - z * z));
+    p.d = Vec3(r * std::cos(phi), r * std::sin(phi), z);
+    const double s_stop = -std::log(1 - rng.uniform()) * v.voxel * 2;
+    const uint16_t label = static_cast<uint16_t>(p.label);
+    int axis_ref = -1, end_ref[3];
+    const double s_ref = march_to_change(v, p, s_stop, axis_ref, end_ref, nullptr,
+                                         [&](ptrdiff_t i) { return v.labels[i] == label; });
+    for (const bool with_faces : {false, true}) {
+      VoxelCrossings faces;
+      int axis = -1, end[3];
+      const double s =
+          space.distance_to_interface(p, s_stop, axis, end, with_faces ? &faces : nullptr);
+      ++compared;
+      REQUIRE(s == s_ref);
+      if (std::isfinite(s)) {
+        CHECK(axis == axis_ref);
+        CHECK((end[0] == end_ref[0] && end[1] == end_ref[1] && end[2] == end_ref[2]));
+        continue;
+      }
+      skipped += !with_faces;
+      // The end voxel holds the end of the step.
+      const Vec3 x1 = p.x + p.d * s_stop;
+      for (int a = 0; a < 3; ++a) {
+        CHECK(std::abs(end[a] - end_ref[a]) <= 1);
+        CHECK(x1[a] >= v.origin[a] + end[a] * v.voxel - 1e-9);
+        CHECK(x1[a] <= v.origin[a] + (end[a] + 1) * v.voxel + 1e-9);
+      }
+    }
+  }
+  CHECK(compared > 30000);
+  CHECK(skipped > 3000);  // the boxes are used
+}
