@@ -147,7 +147,8 @@ uint64_t memory_bytes(const Setup& s, int threads) {
   const uint64_t record = 8 * 2 + 4 * 2 + 8 * (s.volume.optics.size());
   if (!s.detectors.empty() && s.save_detected)
     bytes += record * std::min<uint64_t>(s.max_detected, s.photons);
-  return bytes + s.volume.memory_bytes();
+  // The walk's safe distances: one byte per voxel (core/transport/safe_distance.h).
+  return bytes + s.volume.memory_bytes() + s.volume.cells();
 }
 
 Result simulate(const Setup& s) {
