@@ -1,6 +1,8 @@
 #include "apps/render_flags.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 #include "core/error.h"
 
@@ -9,6 +11,7 @@ namespace femto {
 const char* RenderOverrides::camera_only_flag() const {
   return spp                    ? "--spp"
          : max_depth            ? "--max-depth"
+         : roulette             ? "--russian-roulette"
          : sampling             ? "--distance-sampling"
          : connection           ? "--connection-sampling"
          : direction            ? "--direction-sampling"
@@ -20,6 +23,33 @@ const char* RenderOverrides::camera_only_flag() const {
          : photon_bandwidth     ? "--photon-bandwidth"
                                 : nullptr;
 }
+
+namespace {
+// --russian-roulette on | off | DEPTH,THRESHOLD
+RouletteDesc parse_roulette(cli::Args& args) {
+  const std::string v = args.value();
+  if (v == "on") return RouletteDesc{};
+  if (v == "off") return RouletteDesc{0, 1.0};
+  const size_t comma = v.find(',');
+  const char* expected =
+      "expected on, off or DEPTH,THRESHOLD (an integer >= 1, a number in (0, 1])";
+  if (comma == std::string::npos) args.fail(expected, v);
+  RouletteDesc r;
+  try {
+    size_t used = 0;
+    const std::string d = v.substr(0, comma), t = v.substr(comma + 1);
+    const long depth = std::stol(d, &used);
+    if (used != d.size() || depth < 1 || depth > 1000000) args.fail(expected, v);
+    const double threshold = std::stod(t, &used);
+    if (used != t.size() || !(threshold > 0 && threshold <= 1)) args.fail(expected, v);
+    r.depth = static_cast<int>(depth);
+    r.threshold = threshold;
+  } catch (const std::logic_error&) {  // stol / stod: no number, or out of range
+    args.fail(expected, v);
+  }
+  return r;
+}
+}  // namespace
 
 bool parse_render_flag(cli::Args& args, const std::string& a, RenderOverrides& o) {
   if (a == "--spp") {
@@ -123,6 +153,8 @@ bool parse_render_flag(cli::Args& args, const std::string& a, RenderOverrides& o
     if (o.photon_flag.empty()) o.photon_flag = a;
   } else if (a == "--max-depth") {
     o.max_depth = static_cast<int>(args.int_value(1, 1000000));
+  } else if (a == "--russian-roulette") {
+    o.roulette = parse_roulette(args);
   } else {
     return false;
   }
@@ -183,6 +215,7 @@ RenderSetup apply_render_overrides(SceneDesc& desc, const RenderOverrides& o,
   opt.spp = o.spp.value_or(desc.integrator.spp);
   opt.seed = o.seed.value_or(desc.integrator.seed);
   opt.max_depth = o.max_depth.value_or(desc.integrator.max_depth);
+  opt.roulette = o.roulette.value_or(desc.integrator.roulette);
   opt.threads = o.threads;
   return {kind, integrator_why, opt};
 }

@@ -15,6 +15,7 @@ namespace femto {
 /// Overrides of the scene's "render" block and sampling settings; unset ones keep the scene's.
 struct RenderOverrides {
   std::optional<int> spp, max_depth;
+  std::optional<RouletteDesc> roulette;
   std::optional<uint64_t> seed;
   int threads = 0;  ///< 0: all cores
   std::optional<DistanceSampling> sampling;

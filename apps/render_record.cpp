@@ -21,6 +21,12 @@ nlohmann::json scene_json(const std::string& text) {
   return j.is_discarded() ? nlohmann::json(text) : j;
 }
 
+// Russian roulette on camera paths: false, or where it starts and its throughput threshold.
+nlohmann::json roulette_json(IntegratorKind kind, const RouletteDesc& r) {
+  if (kind == IntegratorKind::Light || r.depth <= 0) return false;
+  return {{"depth", r.depth}, {"threshold", r.threshold}};
+}
+
 // Where max_depth came from: a chosen bound ends paths on purpose, the default is a safety bound.
 std::string max_depth_source(bool flag, const IntegratorDesc& d) {
   return flag ? "--max-depth" : d.max_depth_set ? "scene" : "default";
@@ -197,7 +203,7 @@ nlohmann::json render_info(const Scene& scene, const std::string& scene_text, co
                       {"max_depth_source", depth_source},
                       {"integrator", integrator_json(kind, integrator_why, opt, result)},
                       {"reconstruction", reconstruction_json(scene.desc().reconstruction, result)},
-                      {"russian_roulette", false}};
+                      {"russian_roulette", roulette_json(kind, opt.roulette)}};
   nlohmann::json media = nlohmann::json::array();
   {
     for (size_t i = 0; i < scene.desc().media.size(); ++i) {
@@ -236,6 +242,7 @@ nlohmann::json render_info(const Scene& scene, const std::string& scene_text, co
                       {"surface_events", st.surface_events},
                       {"null_boundary_crossings", st.null_crossings},
                       {"max_depth_terminations", st.max_depth_hits},
+                      {"roulette_terminations", st.roulette_ends},
                       {"nonfinite_samples_dropped", st.nonfinite_dropped},
                       {"nonfinite_film_values_zeroed", film_nonfinite},
                       {"light_paths", st.light_paths},

@@ -4,7 +4,9 @@
 // paths/s and the equal-time efficiency against `mfp + collision` (plain path tracing with
 // next-event estimation): the median over pixel-bin cells (typical pixels), the median over the
 // late cells (last third of the window), and the whole film's (summed squared errors: what the
-// rare large errors, the tail, dominate). The default configuration is marked.
+// rare large errors, the tail, dominate). The default configuration is marked; it plays the
+// scene's default Russian roulette, which every other configuration leaves off ("default, no
+// roulette" is the same sampling without it).
 //
 // Error measure: per cell (pixel x bin, channels summed), the mean squared error of one render
 // against a long reference render (32x the samples, seeds of its own, so uncorrelated with every
@@ -97,6 +99,7 @@ struct Config {
   DistanceSampling distance;
   ConnectionSampling connection;
   bool is_default;
+  RouletteDesc roulette{0, 1.0};  ///< off, except where the scene's default is measured
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -115,7 +118,9 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
   }
   const MediumDesc& m0 = base.media[0];
   const Config configs[] = {
-      {"default (mfp + auto)", m0.sampling, m0.connection, true},
+      {"default (mfp + auto, roulette)", m0.sampling, m0.connection, true,
+       base.integrator.roulette},
+      {"default, no roulette", m0.sampling, m0.connection, false},
       {"mis + mis", DistanceSampling::Mis, ConnectionSampling::Mis, false},
       {"mfp + equiangular", DistanceSampling::Mfp, ConnectionSampling::Equiangular, false},
       {"mfp + line_to_point", DistanceSampling::Mfp, ConnectionSampling::LineToPoint, false},
@@ -149,6 +154,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
       opt.threads = 1;
       opt.quiet = true;
       opt.seed = 1 + static_cast<uint64_t>(r);
+      opt.roulette = configs[k].roulette;
       const RenderResult res = render(*scenes[static_cast<size_t>(k)], opt);
       secs[static_cast<size_t>(k)].push_back(res.wall_seconds);
       stats[static_cast<size_t>(k)] = res.stats;
@@ -166,7 +172,9 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
   ref_opt.threads = 0;
   ref_opt.quiet = true;
   ref_opt.seed = 1000003;
-  const RenderResult ref_res = render(*scenes[4], ref_opt);  // mfp + mis
+  int c_mis = 0;
+  while (std::string(configs[c_mis].name) != "mfp + mis") ++c_mis;
+  const RenderResult ref_res = render(*scenes[static_cast<size_t>(c_mis)], ref_opt);
   std::vector<double> ref(cells);
   for (size_t i = 0; i < cells; ++i)
     ref[i] = static_cast<double>(ref_res.film.transient()[3 * i]) +
@@ -179,7 +187,8 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
         mse[i] += (f[i] - ref[i]) * (f[i] - ref[i]) / reps;
     return mse;
   };
-  const int c_ref = n - 1;
+  int c_ref = 0;  // mfp + collision: the baseline
+  while (std::string(configs[c_ref].name) != "mfp + collision") ++c_ref;
   const std::vector<double> mse_c = mse_of(c_ref);
   const double time_c = median(secs[static_cast<size_t>(c_ref)]);
   double ref_total = 0;
@@ -188,7 +197,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
               bs.name, width, height, bins, spp, reps,
               static_cast<double>(stats[static_cast<size_t>(c_ref)].medium_events) /
                   static_cast<double>(stats[static_cast<size_t>(c_ref)].paths));
-  std::printf("  %-27s %10s %12s %12s %12s %18s\n", "configuration", "paths/s", "median eff.",
+  std::printf("  %-31s %10s %12s %12s %12s %18s\n", "configuration", "paths/s", "median eff.",
               "late eff.", "film eff.", "total vs reference");
   for (int k = 0; k < n; ++k) {
     const double t = median(secs[static_cast<size_t>(k)]);
@@ -198,7 +207,8 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
     for (size_t i = 0; i < cells; ++i) {
       sum_mse += mse[i];
       sum_mse_c += mse_c[i];
-      if (!(ref[i] > (all_cells ? 0.0 : bs.min_signal) * peak && mse[i] > 0 && mse_c[i] > 0)) continue;
+      if (!(ref[i] > (all_cells ? 0.0 : bs.min_signal) * peak && mse[i] > 0 && mse_c[i] > 0))
+        continue;
       const double e = (mse_c[i] * time_c) / (mse[i] * t);
       all.push_back(e);
       if (static_cast<int>(i % static_cast<size_t>(bins)) >= 2 * bins / 3) late.push_back(e);
@@ -214,7 +224,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
     for (double x : totals) tv += (x - tm) * (x - tm) / (reps - 1);
     char late_text[32] = "           -";  // no late cell with signal
     if (!late.empty()) std::snprintf(late_text, sizeof(late_text), "%11.2fx", median(late));
-    std::printf("%s %-27s %10.3g %11.2fx %s %11.3fx %10.3f +- %.3f\n",
+    std::printf("%s %-31s %10.3g %11.2fx %s %11.3fx %10.3f +- %.3f\n",
                 configs[k].is_default ? "*" : " ", configs[k].name,
                 static_cast<double>(stats[static_cast<size_t>(k)].paths) / t, median(all),
                 late_text, sum_mse > 0 ? (sum_mse_c * time_c) / (sum_mse * t) : 0.0, tm,

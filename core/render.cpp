@@ -109,7 +109,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
   const ReconstructionDesc& rec = scene.desc().reconstruction;
   const bool kernel = rec.type == TemporalFilter::Kind::Kernel;
   const TemporalFilter filter(axis, rec.type, rec.kernel);
-  const VolPathIntegrator integrator(scene, filter, opt.max_depth);
+  const VolPathIntegrator integrator(scene, filter, opt.max_depth, opt.roulette);
   const size_t pixels = static_cast<size_t>(W) * static_cast<size_t>(H);
 
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;

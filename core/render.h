@@ -26,6 +26,9 @@ struct RenderOptions {
   uint64_t seed = 1;
   int threads = 0;       ///< 0: all hardware threads
   int max_depth = 1000;
+  /// Russian roulette on camera paths: off unless set (`femto render` sets the scene's,
+  /// through RenderSetup; benchmarks and tests choose it explicitly).
+  RouletteDesc roulette{0, 1.0};
   bool quiet = false;    ///< no progress on stderr
 
   // Passes, interruption and resume. A render runs in passes (camera paths, histogram film: a

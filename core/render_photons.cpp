@@ -34,7 +34,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const int W = camera.width(), H = camera.height();
   const TimeAxis axis = scene.desc().time;
   const TemporalFilter filter(axis, TemporalFilter::Kind::Histogram);
-  const VolPathIntegrator integrator(scene, filter, opt.max_depth);
+  const VolPathIntegrator integrator(scene, filter, opt.max_depth, opt.roulette);
   const IntegratorKind kind = opt.integrator;
   // Photons: photons on surfaces; beams: all beams; hybrid: photons and caustic beams.
   const bool use_photons = kind != IntegratorKind::Beams;

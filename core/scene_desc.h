@@ -176,6 +176,14 @@ struct PhotonDesc {
   TemporalKernel kernel = TemporalKernel::Epanechnikov;
 };
 
+/// Russian roulette on camera paths (docs/scene-format.md, "render"): after the scattering or
+/// bounce at vertex `depth` and later, a path whose throughput's largest component b is below
+/// `threshold` goes on with probability b / threshold, its throughput divided by it (unbiased).
+struct RouletteDesc {
+  int depth = 3;           ///< first vertex where the roulette may end a path; 0 = off
+  double threshold = 0.2;  ///< throughput below which it plays, in (0, 1]
+};
+
 struct IntegratorDesc {
   int spp = 16;
   int max_depth = 1000;          ///< safety bound on scattering/bounce vertices per path
@@ -184,6 +192,7 @@ struct IntegratorDesc {
   IntegratorKind kind = IntegratorKind::Auto;
   int64_t light_paths = 0;       ///< light tracing: paths in all; 0 = spp x width x height
   PhotonDesc photons;
+  RouletteDesc roulette;
 };
 
 struct SceneDesc {

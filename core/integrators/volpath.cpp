@@ -17,11 +17,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& filter,
-                                     int max_depth)
+                                     int max_depth, const RouletteDesc& roulette)
     : scene_(scene),
       tracker_(scene),
       filter_(filter),
       max_depth_(max_depth),
+      roulette_(roulette),
       unwarp_(scene.desc().time_mode == TimeMode::Unwarp) {
   // Contributions are deposited with up to 8 sigma of pulse spread (see TemporalFilter).
   t_cut_ = filter.axis().t_end_ps() - scene.lights().min_offset_ps() +
@@ -275,7 +276,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
         Vec3 wi;
         beta *=
             sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone
-        if (beta.is_black()) break;
+        if (beta.is_black() || !survives_roulette(depth, beta, rng, stats)) break;
         specular = false;
         prev_p = x;
         ray = {x, wi};
@@ -332,7 +333,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     const double u_lobe = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
     if (!bsdf.sample(wo, u_lobe, u1, u2, TransportMode::Radiance, bs)) break;
     beta *= bs.weight;
-    if (beta.is_black()) break;
+    if (beta.is_black() || !survives_roulette(depth, beta, rng, stats)) break;
     const bool wi_outside = bs.wi.z > 0;
     if (bs.transmitted)
       m = wi_outside ? scene_.outside_medium(hit.shape) : scene_.inside_medium(hit.shape);

@@ -25,7 +25,8 @@ struct BeamGather;
 
 class VolPathIntegrator {
  public:
-  VolPathIntegrator(const Scene& scene, const TemporalFilter& filter, int max_depth);
+  VolPathIntegrator(const Scene& scene, const TemporalFilter& filter, int max_depth,
+                    const RouletteDesc& roulette = {0, 1.0});
 
   /// Traces one camera path starting on `ray` (in the outside medium) and adds its
   /// contributions to `acc`. With `photons`, caustic paths (light -> non-diffuse surfaces ->
@@ -120,6 +121,19 @@ class VolPathIntegrator {
                PathStats& stats) const;
   /// Next-event estimation at a surface vertex with a non-delta BSDF (local frame z = ng); m_wo
   /// is the medium on the side of wo (the path's).
+  /// Russian roulette after the vertex at `depth`: false ends the path; a survivor's beta is
+  /// divided by its probability.
+  bool survives_roulette(int depth, RGB& beta, Rng& rng, PathStats& stats) const {
+    if (roulette_.depth <= 0 || depth < roulette_.depth) return true;
+    const double q = beta.max_component() / roulette_.threshold;
+    if (q >= 1.0) return true;
+    if (rng.uniform() >= q) {
+      ++stats.roulette_ends;
+      return false;
+    }
+    beta *= 1.0 / q;
+    return true;
+  }
   void estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame,
                                const Vec3& wo, bool wo_outside, int m_wo, const RGB& beta, double t,
                                Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
@@ -128,6 +142,7 @@ class VolPathIntegrator {
   MediumTracker tracker_;
   TemporalFilter filter_;
   int max_depth_;
+  RouletteDesc roulette_;
   bool unwarp_;
   double t_cut_;
   std::vector<int> point_lights_;  ///< point and spot lights: targets of angular sampling

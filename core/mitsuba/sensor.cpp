@@ -209,8 +209,8 @@ void Importer::integrator(Node n) {
     }
     if (const Node rr = take(p, "rr_depth"))
       warn(rr,
-           "not used: femto applies no Russian roulette (paths end at the time window's end "
-           "or at max_depth)");
+           "not used: femto plays its own Russian roulette on camera paths, by throughput "
+           "(/render/russian_roulette in the translated scene)");
     for (const char* unused : {"temporal_filter", "gaussian_stddev", "block_size"})
       if (const Node u = take(p, unused)) warn(u, "not used");
     if (p.by_name.count("camera_unwarp")) {

@@ -150,6 +150,7 @@ class Loader {
 
   // render.cpp: integrator settings.
   void photons(const Json& v, const std::string& p, PhotonDesc& d) const;
+  void roulette(const Json& v, const std::string& p, RouletteDesc& d) const;
   void render(const Json& v, IntegratorDesc& d) const;
 };
 

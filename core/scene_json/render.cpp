@@ -25,10 +25,27 @@ void Loader::photons(const Json& v, const std::string& p, PhotonDesc& d) const {
                    : TemporalKernel::Epanechnikov;
 }
 
+// Russian roulette on camera paths: true (from vertex 3, throughput threshold 0.2), false, or
+// {"depth", "threshold"}.
+void Loader::roulette(const Json& v, const std::string& p, RouletteDesc& d) const {
+  if (v.is_boolean()) {
+    d = v.get<bool>() ? RouletteDesc{} : RouletteDesc{0, 1.0};
+    return;
+  }
+  if (!v.is_object()) fail(p, "expected true, false or an object {\"depth\", \"threshold\"}", v);
+  check_keys(v, p, {"depth", "threshold"});
+  d = RouletteDesc{};
+  if (const Json* s = find(v, "depth")) d.depth = int_in(*s, at(p, "depth"), 1, 1000000);
+  if (const Json* s = find(v, "threshold"))
+    d.threshold = number(*s, at(p, "threshold"), within(0, 1, true, false));
+}
+
 void Loader::render(const Json& v, IntegratorDesc& d) const {
   const std::string p = "/render";
   const Json& o = object(v, p);
-  check_keys(o, p, {"spp", "max_depth", "seed", "integrator", "light_paths", "photons"});
+  check_keys(
+      o, p,
+      {"spp", "max_depth", "seed", "integrator", "light_paths", "photons", "russian_roulette"});
   if (const Json* s = find(o, "spp")) d.spp = int_in(*s, at(p, "spp"), 1, 10000000);
   if (const Json* s = find(o, "integrator")) {
     const std::string k =
@@ -43,6 +60,8 @@ void Loader::render(const Json& v, IntegratorDesc& d) const {
   if (const Json* s = find(o, "light_paths"))
     d.light_paths = integer(*s, at(p, "light_paths"), 1, 1000000000000LL);
   if (const Json* s = find(o, "photons")) photons(*s, at(p, "photons"), d.photons);
+  if (const Json* s = find(o, "russian_roulette"))
+    roulette(*s, at(p, "russian_roulette"), d.roulette);
   if (const Json* s = find(o, "max_depth")) {
     d.max_depth = int_in(*s, at(p, "max_depth"), 1, 1000000);
     d.max_depth_set = true;

@@ -18,6 +18,7 @@ PathStats& PathStats::operator+=(const PathStats& o) {
   surface_events += o.surface_events;
   null_crossings += o.null_crossings;
   max_depth_hits += o.max_depth_hits;
+  roulette_ends += o.roulette_ends;
   nonfinite_dropped += o.nonfinite_dropped;
   light_paths += o.light_paths;
   photons_stored += o.photons_stored;

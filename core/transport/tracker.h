@@ -15,6 +15,7 @@ struct PathStats {
   uint64_t surface_events = 0;     ///< reflections/refractions at surfaces
   uint64_t null_crossings = 0;     ///< passes through index-matched boundaries
   uint64_t max_depth_hits = 0;     ///< paths stopped by the max-depth safety bound
+  uint64_t roulette_ends = 0;      ///< camera paths ended by Russian roulette
   uint64_t nonfinite_dropped = 0;  ///< contributions dropped for being NaN or infinite
   uint64_t light_paths = 0;        ///< light sub-paths (light tracing and photons)
   uint64_t photons_stored = 0;     ///< photons kept for gathering

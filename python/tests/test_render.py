@@ -47,6 +47,7 @@ def test_overrides_equal_the_command_flags(scene_file, tmp_path):
         ({"max_depth": 2, "direction_sampling": "angular"},
          ["--max-depth", "2", "--direction-sampling", "angular"]),
         ({"integrator": "light", "light_paths": 3000}, ["--integrator", "light", "--light-paths", "3000"]),
+        ({"russian_roulette": "1,0.5"}, ["--russian-roulette", "1,0.5"]),
         ({"integrator": "photons", "photons": 2000, "photon_radius": 5.0},
          ["--integrator", "photons", "--photons", "2000", "--photon-radius", "5"]),
     ]
