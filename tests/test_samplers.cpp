@@ -299,7 +299,7 @@ TEST_CASE("Uniform triangle barycentrics are uniform", "[samplers][warps]") {
         femto::sample_uniform_triangle(u1, u2, b1, b2);
         return Point2{b1, b2};
       },
-      [K](double xa, double xb, double ya, double) {
+      [](double xa, double xb, double ya, double) {
         const double h = xb - xa;
         const long ij = std::lround((xa + ya) * K);  // i + j of the cell
         return ij < K - 1 ? 2.0 * h * h : (ij == K - 1 ? h * h : 0.0);
