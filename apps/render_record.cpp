@@ -122,6 +122,12 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
              "R_{j+1} = R_j ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j "
              "+ 1))^beta_t"}};
       j[beams ? "beam_memory_bytes_peak" : "photon_memory_bytes_peak"] = p.peak_photon_bytes;
+      // Where the passes' time went (this session's passes, wall clock): the data for choosing
+      // each part's share of a pass.
+      j["pass_seconds"] = {{"beams", p.seconds_beams},
+                           {"photons", p.seconds_photons},
+                           {"light_paths", p.seconds_light_paths},
+                           {"camera_paths", p.seconds_camera}};
       break;
     }
     case IntegratorKind::Auto:

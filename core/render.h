@@ -92,6 +92,9 @@ struct RenderResult {
     double radius_first = 0, radius_last = 0, bandwidth_first_ps = 0, bandwidth_last_ps = 0;
     uint64_t max_stored_per_pass = 0;
     uint64_t peak_photon_bytes = 0;  ///< largest photon list + grid of one pass
+    /// Wall-clock seconds of this session's passes by part: tracing and building the beams, the
+    /// photons, the hybrid's light paths splatted to the film, and the camera paths (gathers).
+    double seconds_beams = 0, seconds_photons = 0, seconds_light_paths = 0, seconds_camera = 0;
   } photons;
   int64_t light_paths = 0;  ///< light tracing: paths traced
   /// False when the render stopped early (RenderOptions::stop): the film holds the samples done.

@@ -85,6 +85,13 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                                     LightTracer::Vertices::MediumIndirect);
   std::vector<uint32_t> splat_offsets;
   std::vector<const Splat*> splat_order;
+  double seconds_beams = 0, seconds_photons = 0, seconds_light_paths = 0, seconds_camera = 0;
+  auto since = [](std::chrono::steady_clock::time_point& t0) {  // seconds since t0; t0 = now
+    const auto t1 = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(t1 - t0).count();
+    t0 = t1;
+    return s;
+  };
   tbb::task_arena arena(threads);
   arena.execute([&] {
     while (state.units_done < opt.spp) {
@@ -93,6 +100,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       PathStats photon_stats;
       BeamGather beam_gather;
       uint64_t pass_bytes = 0;
+      auto part_start = pass_start;
       if (use_beams) {
         const int64_t paths = bd.per_pass;
         std::vector<Beam> beams = trace_beams(scene, opt.seed, pass, paths, opt.max_depth,
@@ -108,6 +116,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
         beam_gather.inv_paths = 1.0 / static_cast<double>(paths);
         beam_gather.kernel = TemporalFilter(axis, TemporalFilter::Kind::Kernel, bd.kernel);
         beam_gather.caustic_only = caustic_beams;
+        seconds_beams += since(part_start);
       }
       if (use_photons) {
         std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth,
@@ -115,6 +124,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
         state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());
         grid.build(std::move(photons), schedule.radius());
         pass_bytes += grid.memory_bytes();
+        seconds_photons += since(part_start);
       }
       if (light_indirect) {
         const std::vector<Splat> splats = trace_in_chunks<Splat>(
@@ -135,6 +145,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
             splat_offsets, splat_order);
         pass_bytes += splats.size() * (sizeof(Splat) + sizeof(const Splat*)) +
                       (pixels + 1) * sizeof(uint32_t) * 2;
+        seconds_light_paths += since(part_start);
       }
       state.photon_peak_bytes = std::max(state.photon_peak_bytes, pass_bytes);
       PhotonGather gather;
@@ -173,6 +184,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                 }
             }
           });
+      seconds_camera += since(part_start);
       schedule.advance();
       beam_schedule.advance();
       progress.add(1);
@@ -207,6 +219,10 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   rep.bandwidth_last_ps = state.photon_bandwidth_last_ps;
   rep.max_stored_per_pass = state.photon_max_stored;
   rep.peak_photon_bytes = state.photon_peak_bytes;
+  rep.seconds_beams = seconds_beams;
+  rep.seconds_photons = seconds_photons;
+  rep.seconds_light_paths = seconds_light_paths;
+  rep.seconds_camera = seconds_camera;
   result.complete = state.units_done == opt.spp;
   result.units_done = state.units_done;
   result.units_total = opt.spp;

@@ -618,6 +618,19 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     }
     if (cases[i].type == "light") CHECK(integ["light_paths"] == 20000);
     if (cases[i].type == "hybrid") CHECK(integ["caustic_beams"]["alpha"].get<double>() == Approx(2.0 / 3.0));
+    if (cases[i].type != "path" && cases[i].type != "light") {
+      // Each part of a pass is timed where it runs (none where it does not), within the render.
+      const json& ps = integ["pass_seconds"];
+      const bool photons = cases[i].type != "beams", beams = cases[i].type != "photons";
+      const bool light = cases[i].type == "hybrid";
+      CHECK((ps["photons"].get<double>() > 0) == photons);
+      CHECK((ps["beams"].get<double>() > 0) == beams);
+      CHECK((ps["light_paths"].get<double>() > 0) == light);
+      CHECK(ps["camera_paths"].get<double>() > 0);
+      const double parts = ps["photons"].get<double>() + ps["beams"].get<double>() +
+                           ps["light_paths"].get<double>() + ps["camera_paths"].get<double>();
+      CHECK(parts <= info["timing"]["render_seconds"].get<double>() * 1.01 + 1e-3);
+    }
     if (cases[i].type == "beams") {
       CHECK(integ["photons_per_pass"] == 500);
       CHECK(integ["alpha"].get<double>() == Approx(2.0 / 3.0));
