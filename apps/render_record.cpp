@@ -122,12 +122,6 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
              "R_{j+1} = R_j ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j "
              "+ 1))^beta_t"}};
       j[beams ? "beam_memory_bytes_peak" : "photon_memory_bytes_peak"] = p.peak_photon_bytes;
-      // Where the passes' time went (this session's passes, wall clock): the data for choosing
-      // each part's share of a pass.
-      j["pass_seconds"] = {{"beams", p.seconds_beams},
-                           {"photons", p.seconds_photons},
-                           {"light_paths", p.seconds_light_paths},
-                           {"camera_paths", p.seconds_camera}};
       break;
     }
     case IntegratorKind::Auto:
@@ -159,6 +153,7 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
            {{"spp", opt.spp},
             {"seed", opt.seed},
             {"max_depth", opt.max_depth},
+            {"russian_roulette", roulette_json(kind, opt.roulette)},
             {"integrator", integrator_name(kind)},
             {"light_paths", kind == IntegratorKind::Light ? opt.light_paths : 0},
             {"photons", kind != IntegratorKind::Photons && kind != IntegratorKind::Beams &&
@@ -267,6 +262,16 @@ nlohmann::json render_info(const Scene& scene, const std::string& scene_text, co
                       {"sessions", result.sessions},
                       {"stopped_by", stopped_by ? nlohmann::json(stopped_by) : nlohmann::json(nullptr)}};
   if (kind == IntegratorKind::Light) info["progress"]["light_paths_done"] = result.light_paths;
+  // Where the passes' time went (this session's passes, wall clock): the data for choosing each
+  // part's share of a pass.
+  if (kind == IntegratorKind::Photons || kind == IntegratorKind::Beams ||
+      kind == IntegratorKind::Hybrid) {
+    const auto& p = result.photons;
+    info["timing"]["pass_seconds"] = {{"beams", p.seconds_beams},
+                                      {"photons", p.seconds_photons},
+                                      {"light_paths", p.seconds_light_paths},
+                                      {"camera_paths", p.seconds_camera}};
+  }
   if (kernel_film && !result.complete)
     info["progress"]["rows_done"] = std::min<int64_t>(cam.height, result.units_done * 16);
 

@@ -30,6 +30,7 @@ nlohmann::json stats_json(const PathStats& s) {
           {"surface_events", s.surface_events},
           {"null_crossings", s.null_crossings},
           {"max_depth_hits", s.max_depth_hits},
+          {"roulette_ends", s.roulette_ends},
           {"nonfinite_dropped", s.nonfinite_dropped},
           {"light_paths", s.light_paths},
           {"photons_stored", s.photons_stored},
@@ -45,6 +46,7 @@ PathStats stats_of(const nlohmann::json& j) {
   s.surface_events = j.at("surface_events").get<uint64_t>();
   s.null_crossings = j.at("null_crossings").get<uint64_t>();
   s.max_depth_hits = j.at("max_depth_hits").get<uint64_t>();
+  s.roulette_ends = j.value("roulette_ends", uint64_t{0});  // absent in checkpoints before it
   s.nonfinite_dropped = j.at("nonfinite_dropped").get<uint64_t>();
   s.light_paths = j.at("light_paths").get<uint64_t>();
   s.photons_stored = j.at("photons_stored").get<uint64_t>();

@@ -620,7 +620,7 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     if (cases[i].type == "hybrid") CHECK(integ["caustic_beams"]["alpha"].get<double>() == Approx(2.0 / 3.0));
     if (cases[i].type != "path" && cases[i].type != "light") {
       // Each part of a pass is timed where it runs (none where it does not), within the render.
-      const json& ps = integ["pass_seconds"];
+      const json& ps = info["timing"]["pass_seconds"];
       const bool photons = cases[i].type != "beams", beams = cases[i].type != "photons";
       const bool light = cases[i].type == "hybrid";
       CHECK((ps["photons"].get<double>() > 0) == photons);

@@ -301,6 +301,11 @@ TEST_CASE("cli: SIGINT and SIGTERM stop after a pass; --resume gives the uninter
     auto bad = run_femto({"render", "s.json", "--spp", "100", "--resume", out}, tmp.dir);
     CHECK(bad.code == 2);
     CHECK_THAT(bad.err, Catch::Contains("/settings/spp") && Catch::Contains("160"));
+    // The roulette decides the bits too.
+    auto bad_rr = run_femto(
+        {"render", "s.json", "--spp", "160", "--russian-roulette", "off", "--resume", out}, tmp.dir);
+    CHECK(bad_rr.code == 2);
+    CHECK_THAT(bad_rr.err, Catch::Contains("/settings/russian_roulette"));
 
     const auto r = run_femto(with({"--resume", out, "--threads", "2"}), tmp.dir);
     INFO(r.err);
@@ -310,6 +315,10 @@ TEST_CASE("cli: SIGINT and SIGTERM stop after a pass; --resume gives the uninter
     CHECK(done["progress"]["sessions"] == 2);
     CHECK_FALSE(fs::exists(tmp.dir / out / "checkpoint.bin"));
     CHECK(read_file(tmp.dir / out / "transient.npy") == read_file(tmp.dir / "whole" / "transient.npy"));
+    // Counters carry over the sessions, the roulette's included.
+    const json whole = read_json(tmp.dir / "whole" / "render.json");
+    CHECK(done["counters"]["roulette_terminations"] == whole["counters"]["roulette_terminations"]);
+    CHECK(done["counters"]["paths"] == whole["counters"]["paths"]);
   }
 
   // A second signal aborts at once: the previous output stays as it was, nothing else is left.
