@@ -47,6 +47,16 @@ inline MediumDesc graded_voxel_medium(const std::filesystem::path& dir) {
   return m;
 }
 
+/// Progressive photon (or beam) settings of the tests: per pass, first radius (mm) and first
+/// bandwidth (ps); the rest as the scene's defaults.
+inline PhotonDesc progressive(int64_t per_pass, double radius_mm, double bandwidth_ps) {
+  PhotonDesc pd;
+  pd.per_pass = per_pass;
+  pd.radius = radius_mm;
+  pd.bandwidth_ps = bandwidth_ps;
+  return pd;
+}
+
 /// One film per seed (seed0, seed0 + 1, ...) with the given integrator; `work` is spp (passes) or,
 /// for light tracing, light paths.
 inline std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kind, int64_t work,

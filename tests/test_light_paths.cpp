@@ -205,10 +205,7 @@ TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-vox
 TEST_CASE("camera paths + photons agree with light tracing on a caustic from a point light",
           "[light-paths][statistical]") {
   const Scene scene(caustic_scene(axis_of(250, 60, 8)));
-  PhotonDesc pd;
-  pd.per_pass = 40000;
-  pd.radius = 0.5;
-  pd.bandwidth_ps = 1.0;
+  const PhotonDesc pd = progressive(40000, 0.5, 1.0);
   const auto ph = cells(batches(scene, IntegratorKind::Photons, 16, 24, 700, pd), 3, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 40000, 24, 800), 3, 2);
   require_agreement(ph, lt, 10);
@@ -232,10 +229,7 @@ TEST_CASE("path-only and path + photons agree for an emissive sphere behind glas
   std::string why;  // no delta light: camera paths reach everything, so auto keeps them
   CHECK(resolve_integrator(d, IntegratorKind::Auto, why) == IntegratorKind::Path);
   const Scene scene(d);
-  PhotonDesc pd;
-  pd.per_pass = 20000;
-  pd.radius = 0.8;
-  pd.bandwidth_ps = 1.0;
+  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 64, 24, 900), 4, 2);
   const auto ph = cells(batches(scene, IntegratorKind::Photons, 64, 24, 1000, pd), 4, 2);
   require_agreement(pt, ph, 15);

@@ -52,11 +52,8 @@ SceneDesc fog_box(int w, int h) {
 // cell by cell within 4 combined standard errors.
 TEST_CASE("photon beams agree with camera paths in a fog box, bin by bin", "[beams][statistical]") {
   const Scene scene(fog_box(16, 12));
-  PhotonDesc pd;
-  pd.per_pass = 4000;
-  pd.radius =
-      0.5;  // small against the 4 x 4 pixel blocks compared: kernel bias far below the noise
-  pd.bandwidth_ps = 1.0;
+  // Radius small against the 4 x 4 pixel blocks compared: kernel bias far below the noise.
+  const PhotonDesc pd = progressive(4000, 0.5, 1.0);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 128, 24, 100), 4, 3);
   const auto bm = cells(batches(scene, IntegratorKind::Beams, 16, 24, 200, pd), 4, 3);
   require_agreement(pt, bm, 15);
@@ -136,10 +133,8 @@ TEST_CASE("beam renders converge to the camera-path answer bin by bin as passes 
           "[beams][statistical]") {
   const Scene scene(fog_box(16, 12));
   const auto ref = cells(batches(scene, IntegratorKind::Path, 512, 16, 1300), 2, 1);
-  PhotonDesc pd;
-  pd.per_pass = 2000;
-  pd.radius = 10.0;  // wide at first (visible blur near the light), shrinking by the schedule
-  pd.bandwidth_ps = 40.0;
+  // Wide at first (visible blur near the light), shrinking by the schedule.
+  const PhotonDesc pd = progressive(2000, 10.0, 40.0);
   const int n = 24;
   std::vector<std::vector<double>> errors;
   for (int passes : {2, 8, 32}) {
@@ -205,10 +200,7 @@ TEST_CASE("photon beams agree with camera paths in a voxel medium with per-voxel
   d.time.bin_width_ps = 100;
   d.time.bins = 10;
   const Scene scene(d);
-  PhotonDesc pd;
-  pd.per_pass = 4000;
-  pd.radius = 0.5;
-  pd.bandwidth_ps = 1.0;
+  const PhotonDesc pd = progressive(4000, 0.5, 1.0);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 96, 16, 600), 4, 2);
   const auto bm = cells(batches(scene, IntegratorKind::Beams, 16, 16, 700, pd), 4, 2);
   require_agreement(pt, bm, 10);
@@ -279,10 +271,7 @@ TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog"
       { "type": "sphere", "center": [-15, 70, 0], "radius": 5, "emission": 30,
         "material": { "type": "diffuse", "albedo": 0 } })");
   const Scene scene(d);
-  PhotonDesc pd;
-  pd.per_pass = 20000;
-  pd.radius = 0.8;
-  pd.bandwidth_ps = 1.0;
+  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 192, 24, 800), 4, 2);
   const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 64, 24, 900, pd), 4, 2);
   require_agreement(pt, hy, 12, 0.025);  // a 10% error would be 4 standard errors
@@ -297,10 +286,7 @@ TEST_CASE("hybrid agrees with light tracing on a volumetric caustic from a point
   const SceneDesc d =
       glass_in_fog(R"({ "type": "point", "position": [-30, 80, 0], "intensity": 3000 })", "");
   const Scene scene(d);
-  PhotonDesc pd;
-  pd.per_pass = 20000;
-  pd.radius = 0.8;
-  pd.bandwidth_ps = 1.0;
+  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
   std::vector<TransientFilm> lt;
   for (int b = 0; b < 24; ++b) {
     RenderOptions opt;
@@ -366,10 +352,7 @@ TEST_CASE("hybrid and beams agree for a laser entering a medium through a refrac
   with_floor.shapes.push_back(quad({-30, -9, 30}, {60, 0, 0}, {0, 0, -60}, diffuse(0.5)));
   CHECK(resolve_integrator(with_floor, IntegratorKind::Auto, why) == IntegratorKind::Hybrid);
   const Scene scene(d);
-  PhotonDesc pd;
-  pd.per_pass = 3000;
-  pd.radius = 0.5;
-  pd.bandwidth_ps = 1.0;
+  const PhotonDesc pd = progressive(3000, 0.5, 1.0);
   const auto bm = cells(batches(scene, IntegratorKind::Beams, 16, 16, 1200, pd), 4, 2);
   // The hybrid is heavy-tailed here (camera paths must scatter their way to the laser's first
   // segments), so its cells are noisy and the totals decide: a 17% error in the hybrid's total

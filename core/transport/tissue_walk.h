@@ -215,11 +215,11 @@ class LabelSpace {
                                VoxelCrossings* crossed) const {
     // Far from other labels (most steps in a large tissue): no label to look up.
     const int safe = safe_[vol_.index(p.cell[0], p.cell[1], p.cell[2])];
-    if (inside_safe_box(vol_, p.cell, safe, p.x + p.d * s_stop, margin_)) {
+    const Vec3 x1 = p.x + p.d * s_stop;
+    if (inside_safe_box(vol_, p.cell, safe, x1, margin_)) {
       if (crossed)  // the faces for a tally; every neighbour has the label
         return march_to_change(vol_, p, s_stop, axis, end_cell, crossed,
                                [](ptrdiff_t) { return true; });
-      const Vec3 x1 = p.x + p.d * s_stop;
       for (int a = 0; a < 3; ++a)
         end_cell[a] =
             std::clamp(static_cast<int>(std::floor((x1[a] - vol_.origin[a]) / vol_.voxel)),
