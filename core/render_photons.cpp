@@ -39,6 +39,13 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   // Photons: photons on surfaces; beams: all beams; hybrid: photons and caustic beams.
   const bool use_photons = kind != IntegratorKind::Beams;
   const bool use_beams = kind != IntegratorKind::Photons;
+  // Photons are stored at diffuse surfaces only: without one, tracing them would cost a share of
+  // every pass and change nothing (a hybrid render of glass in fog).
+  const bool trace_surface_photons =
+      use_photons && std::any_of(scene.desc().shapes.begin(), scene.desc().shapes.end(),
+                                 [](const ShapeDesc& sh) {
+                                   return sh.material.type == MaterialDesc::Type::Diffuse;
+                                 });
   const bool caustic_beams = kind == IntegratorKind::Hybrid;
   const PhotonDesc pd = progressive_settings(
       scene, kind == IntegratorKind::Beams ? IntegratorKind::Beams : IntegratorKind::Photons,
@@ -118,7 +125,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
         beam_gather.caustic_only = caustic_beams;
         seconds_beams += since(part_start);
       }
-      if (use_photons) {
+      if (trace_surface_photons) {
         std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth,
                                                     photon_t_cut, photon_stats, opt.comm);
         state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());

@@ -639,6 +639,29 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
   }
 }
 
+// Catches: photons traced in every hybrid pass of a scene where nothing can store them (no
+// diffuse surface: glass in fog), a share of each pass for nothing.
+TEST_CASE("cli: the hybrid traces no photons without a diffuse surface", "[cli]") {
+  CliTempDir tmp;
+  json s = small_scene();
+  s["shapes"] = json::parse(R"([ { "type": "sphere", "center": [0, 0, 20], "radius": 10,
+                                   "material": { "type": "dielectric", "eta": 1.5 } } ])");
+  write_text(tmp.dir / "glass.json", s.dump(2));
+  const fs::path out = tmp.dir / "out";
+  const RunResult r = run_femto({"render", (tmp.dir / "glass.json").string(), "--spp", "2",
+                                 "--integrator", "hybrid", "--photons", "500", "--out",
+                                 out.string(), "--quiet", "--frames", "none", "--no-previews"},
+                                tmp.dir, tmp.dir / "logs");
+  INFO(r.command << "\nstderr: " << r.err);
+  REQUIRE(r.code == 0);
+  const json info = json::parse(read_text(out / "render.json"));
+  CHECK(info["timing"]["pass_seconds"]["photons"].get<double>() == 0.0);
+  CHECK(info["timing"]["pass_seconds"]["beams"].get<double>() > 0.0);
+  // Per pass: 500 beam light paths and one indirect light path per pixel (40 x 24), no photons.
+  CHECK(info["counters"]["light_paths"].get<uint64_t>() == 2u * (500u + 40u * 24u));
+  CHECK(info["counters"]["photons_stored"].get<uint64_t>() == 0u);
+}
+
 // Catches: photon and light-path settings accepted where they mean nothing or with impossible
 // values, and an integrator that cannot handle the scene's film, each with a clear exit-2
 // message and nothing written.
