@@ -89,21 +89,24 @@ SceneDesc housed_emitter_scene(const SceneDesc& spot, double r) {
   return d;
 }
 
+/// Whether the camera ray of pixel (x, y) through its centre or a corner meets `sphere`.
+bool pixel_sees_sphere(const Camera& cam, int x, int y, const ShapeDesc& sphere) {
+  for (const auto& c : {std::pair<double, double>{0.5, 0.5}, {0, 0}, {1, 0}, {0, 1}, {1, 1}}) {
+    const Ray r = cam.generate_ray(x + c.first, y + c.second);
+    const Vec3 oc = r.o - sphere.center;
+    const double b = dot(oc, r.d), cc = dot(oc, oc) - sphere.radius * sphere.radius;
+    if (b * b - cc > 0 && -b + std::sqrt(b * b - cc) > 0) return true;
+  }
+  return false;
+}
+
 /// Crop pixels whose camera rays (centre and corners) miss the glass sphere.
 std::vector<int> crop_pixels(const Scene& scene, const Options& o, const ShapeDesc& glass) {
   std::vector<int> px;
   const Camera& cam = scene.camera();
   for (int y = o.y0; y < o.y1; ++y)
-    for (int x = o.x0; x < o.x1; ++x) {
-      bool sees_glass = false;
-      for (const auto& c : {std::pair<double, double>{0.5, 0.5}, {0, 0}, {1, 0}, {0, 1}, {1, 1}}) {
-        const Ray r = cam.generate_ray(x + c.first, y + c.second);
-        const Vec3 oc = r.o - glass.center;
-        const double b = dot(oc, r.d), cc = dot(oc, oc) - glass.radius * glass.radius;
-        sees_glass = sees_glass || (b * b - cc > 0 && -b + std::sqrt(b * b - cc) > 0);
-      }
-      if (!sees_glass) px.push_back(y * cam.width() + x);
-    }
+    for (int x = o.x0; x < o.x1; ++x)
+      if (!pixel_sees_sphere(cam, x, y, glass)) px.push_back(y * cam.width() + x);
   return px;
 }
 
@@ -119,14 +122,7 @@ std::vector<bool> glass_blocks(const Scene& scene, int B) {
       continue;
     for (int y = 0; y < cam.height(); ++y)
       for (int x = 0; x < cam.width(); ++x)
-        for (const auto& c :
-             {std::pair<double, double>{0.5, 0.5}, {0, 0}, {1, 0}, {0, 1}, {1, 1}}) {
-          const Ray r = cam.generate_ray(x + c.first, y + c.second);
-          const Vec3 oc = r.o - g.center;
-          const double b = dot(oc, r.d), cc = dot(oc, oc) - g.radius * g.radius;
-          if (b * b - cc > 0 && -b + std::sqrt(b * b - cc) > 0)
-            out[static_cast<size_t>((y / B) * bw + x / B)] = true;
-        }
+        if (pixel_sees_sphere(cam, x, y, g)) out[static_cast<size_t>((y / B) * bw + x / B)] = true;
   }
   return out;
 }

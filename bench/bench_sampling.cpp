@@ -200,12 +200,14 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
            static_cast<size_t>(b / kBlockBins);
   };
   const size_t blocks = static_cast<size_t>(bw) * static_cast<size_t>(bh) * static_cast<size_t>(bb);
-  auto pool = [&](const std::vector<double>& v) {
+  auto pool = [&](const auto& v) {  // cell values (float or double) summed per block
     std::vector<double> out(blocks, 0.0);
     for (size_t i = 0; i < cells; ++i) out[block_of(i)] += v[i];
     return out;
   };
   const std::vector<double> ref_block = pool(ref);
+  // Cells (blocks) count above this fraction of the reference's peak cell (block).
+  const double min_signal = all_cells ? 0.0 : bs.min_signal;
   const double peak = percentile(ref, 0.999);
   const double peak_block = percentile(ref_block, 0.999);
   auto mse_of = [&](int k) {
@@ -218,8 +220,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
   auto mse_block_of = [&](int k) {
     std::vector<double> mse(blocks, 0.0);
     for (const auto& f : films[static_cast<size_t>(k)]) {
-      std::vector<double> sum(blocks, 0.0);
-      for (size_t i = 0; i < cells; ++i) sum[block_of(i)] += f[i];
+      const std::vector<double> sum = pool(f);
       for (size_t j = 0; j < blocks; ++j)
         mse[j] += (sum[j] - ref_block[j]) * (sum[j] - ref_block[j]) / reps;
     }
@@ -237,10 +238,9 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
   // well on the median, and only the pooled figures (block, film) mean something.
   std::vector<double> rel_cell, rel_block;
   for (size_t i = 0; i < cells; ++i)
-    if (ref[i] > (all_cells ? 0.0 : bs.min_signal) * peak)
-      rel_cell.push_back(std::sqrt(mse_c[i]) / ref[i]);
+    if (ref[i] > min_signal * peak) rel_cell.push_back(std::sqrt(mse_c[i]) / ref[i]);
   for (size_t j = 0; j < blocks; ++j)
-    if (ref_block[j] > (all_cells ? 0.0 : bs.min_signal) * peak_block)
+    if (ref_block[j] > min_signal * peak_block)
       rel_block.push_back(std::sqrt(mse_block_c[j]) / ref_block[j]);
   std::printf(
       "\n%s: %d x %d px, %d bins, %d spp x %d seeds, %.2f medium events per path\n"
@@ -262,8 +262,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
     for (size_t i = 0; i < cells; ++i) {
       sum_mse += mse[i];
       sum_mse_c += mse_c[i];
-      if (!(ref[i] > (all_cells ? 0.0 : bs.min_signal) * peak && mse[i] > 0 && mse_c[i] > 0))
-        continue;
+      if (!(ref[i] > min_signal * peak && mse[i] > 0 && mse_c[i] > 0)) continue;
       const double e = (mse_c[i] * time_c) / (mse[i] * t);
       all.push_back(e);
       if (static_cast<int>(i % static_cast<size_t>(bins)) >= 2 * bins / 3) late.push_back(e);
@@ -271,8 +270,7 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
     const std::vector<double> mse_block = mse_block_of(k);
     std::vector<double> block_eff;
     for (size_t j = 0; j < blocks; ++j)
-      if (ref_block[j] > (all_cells ? 0.0 : bs.min_signal) * peak_block && mse_block[j] > 0 &&
-          mse_block_c[j] > 0)
+      if (ref_block[j] > min_signal * peak_block && mse_block[j] > 0 && mse_block_c[j] > 0)
         block_eff.push_back((mse_block_c[j] * time_c) / (mse_block[j] * t));
     std::vector<double> totals;
     for (const auto& f : films[static_cast<size_t>(k)]) {
