@@ -129,10 +129,14 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
 IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, std::string& why);
 const char* integrator_name(IntegratorKind kind);
 
+/// Beam light paths per pass when the scene sets none: half the film's pixels, within
+/// [1000, 20000].
+int64_t default_beam_paths_per_pass(int64_t pixels);
+
 /// `p` with its automatic values filled in for `kind` (Photons or Beams). Photons: 200000 per
 /// pass, R_1 = 0.5% of the scene's bounding-box diagonal, alpha = 4/7, beta_t = 1/3. Beams:
-/// 20000 light paths per pass, R_1 = 1% of the diagonal, alpha = 2/3, beta_t = 1/2. Both:
-/// T_1 = one time bin.
+/// default_beam_paths_per_pass light paths per pass, R_1 = 1% of the diagonal, alpha = 2/3,
+/// beta_t = 1/2. Both: T_1 = one time bin.
 PhotonDesc progressive_settings(const Scene& scene, IntegratorKind kind, PhotonDesc p);
 
 /// Traces the spp samples of pixel (x, y) into `acc` (reset first) with the scene's temporal
