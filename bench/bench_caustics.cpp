@@ -361,6 +361,7 @@ int main(int argc, char** argv) {
   Options o;
   std::string scene_file;
   int ref_passes = 100, width = 0, height = 0;
+  bool through_glass = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -380,6 +381,8 @@ int main(int argc, char** argv) {
       o.seed = std::strtoull(next().c_str(), nullptr, 10);
     else if (a == "--scene")
       scene_file = next();
+    else if (a == "--through-glass")
+      through_glass = true;
     else if (a == "--ref-passes")
       ref_passes = std::atoi(next().c_str());
     else if (a == "--size") {
@@ -395,9 +398,9 @@ int main(int argc, char** argv) {
     } else if (a == "--help") {
       std::printf(
           "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S] "
-          "[--crop X0,Y0,X1,Y1]\n  default crop: the caustic on the floor; --crop 100,88,156,128: "
-          "the fog "
-          "under the sphere\n"
+          "[--crop X0,Y0,X1,Y1] [--through-glass]\n  default crop: the caustic on the floor; "
+          "--crop 100,88,156,128: the fog under the sphere; --through-glass: the spot aimed at "
+          "the sphere, its cone inside the sphere's silhouette (all light is a caustic's)\n"
           "       femto-bench-caustics --scene FILE [--ref-passes N] [--size W,H] [--seconds S] "
           "[--threads N]\n"
           "  a scene whose light camera paths cannot reach (data/scenes/tissue_laser.json): "
@@ -418,10 +421,22 @@ int main(int argc, char** argv) {
       "femto-bench-caustics: CPU %s, %d threads, %.0f s per estimator, references of %.3g light "
       "paths\n",
       cpu_model().c_str(), o.threads, o.seconds, o.ref_paths);
-  const SceneDesc spot_desc = load_scene_string(default_scene_json(), "<default scene>", ".");
+  SceneDesc spot_desc = load_scene_string(default_scene_json(), "<default scene>", ".");
   const ShapeDesc* glass = nullptr;
   for (const ShapeDesc& s : spot_desc.shapes)
     if (s.material.type == MaterialDesc::Type::Dielectric) glass = &s;
+  if (through_glass) {
+    // All of the spot's light through the sphere: aimed at its centre, the cone inside its
+    // silhouette, so every bit of light in the fog and on the walls is a caustic's.
+    LightDesc& l = spot_desc.lights.front();
+    const Vec3 to = glass->center - l.position;
+    l.direction = normalize(to);
+    l.cone_angle_deg =
+        0.95 * std::asin(glass->radius / length(to)) * 180.0 / 3.14159265358979323846;
+    l.falloff_deg = 0.8 * l.cone_angle_deg;
+    std::printf("spot aimed at the glass sphere, cone half-angle %.2f deg (falloff from %.2f)\n",
+                l.cone_angle_deg, l.falloff_deg);
+  }
   const Scene spot(spot_desc);
   const Scene sphere(sphere_emitter_scene(spot_desc, 2.0));
   const Scene housed(housed_emitter_scene(spot_desc, 2.0));
