@@ -36,19 +36,24 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
   const Camera& cam = scene_.camera();
   const double eps = scene_.ray_epsilon();
   const bool indirect_only = vertices_ == Vertices::MediumIndirect;
-  bool scattered = false;  // a diffuse surface or medium vertex so far
+  bool scattered = false;    // a diffuse surface or medium vertex so far
+  bool from_medium = false;  // the previous vertex scattered in a medium
   walk_light_path(scene_, tracker_, rng, max_depth_, t_cut_, stats, [&](const LightVertex& v) {
     if (indirect_only) {
       if (v.kind == LightVertex::Kind::Surface) {
         scattered = scattered || v.bsdf->is_diffuse();
-        return true;
+        // Light scattered in a medium onto a diffuse surface: light -> X* M -> D -> sensor.
+        const bool splat_here = from_medium && v.bsdf->is_diffuse();
+        from_medium = false;
+        if (!splat_here) return true;
+      } else {
+        if (v.kind != LightVertex::Kind::Medium) return true;
+        const bool after_scattering = scattered;
+        if (!v.connection_only) scattered = from_medium = true;
+        // Direct light (light -> M) and caustics (light -> (S|G)+ -> M) are the camera paths'
+        // and the beams' share.
+        if (!after_scattering) return true;
       }
-      if (v.kind != LightVertex::Kind::Medium) return true;
-      const bool after_scattering = scattered;
-      if (!v.connection_only) scattered = true;
-      // Direct light (light -> M) and caustics (light -> (S|G)+ -> M) are the camera paths' and
-      // the beams' share.
-      if (!after_scattering) return true;
     }
     double fx, fy, dist, W;
     Vec3 w;

@@ -199,13 +199,16 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   // is a medium vertex: past x_c the path only looks for an emitter hit (the other half of x_c's
   // next-event MIS) and ends at its next vertex.
   bool past_xc = false;
+  // It also owns light -> X* M -> x_c -> camera with x_c a diffuse surface: on the segment leaving
+  // such an x_c the path takes no light scattered in the medium and ends at a collision.
+  bool from_xd = false;
 
   for (;;) {
     SurfaceHit hit;
     const bool found = scene_.geometry().intersect(ray, 0.0, kInf, hit);
     const double s_surf = found ? hit.s : kInf;
     const Medium& med = media[static_cast<size_t>(m)];
-    if (caustic_beams && med.interacts() && depth < max_depth_ && !past_xc)
+    if (caustic_beams && med.interacts() && depth < max_depth_ && !past_xc && !from_xd)
       beams->gather(m, ray, s_surf, beta, t,
                     unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
     if (beam_prefix && med.interacts()) {
@@ -227,7 +230,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
       const ConnectedSegment segment =
           plan_segment(med, ray, s_surf, t, t_dropped, on_camera_segment);
-      if ((segment.active || segment.time_mis) && depth < max_depth_ && !past_xc)
+      if ((segment.active || segment.time_mis) && depth < max_depth_ && !past_xc && !from_xd)
         estimate_segment(med, m, segment, beta, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every
       // strategy's MIS weight at this segment's vertices sees the same r_aux.
@@ -238,7 +241,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const DirectionMix mix_main =
           angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next, depth + 1)
                   : DirectionMix{};
-      if (ms.extra.collided && depth < max_depth_ && !past_xc) {
+      if (ms.extra.collided && depth < max_depth_ && !past_xc && !from_xd) {
         // The time-uniform collision of MIS: next-event estimation only (the path goes on from
         // the mean-free-path collision).
         const Vec3 x2 = ray.at(ms.extra.s);
@@ -257,7 +260,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
 
       if (ev.collided) {
         // Real collision: absorb by weighting with the single-scattering albedo.
-        if (past_xc) break;
+        if (past_xc || from_xd) break;
         past_xc = light_indirect && on_camera_segment;
         on_camera_segment = false;
         last = Last::Medium;
@@ -305,6 +308,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       continue;
     }
     if (past_xc) break;
+    from_xd = false;
+    const bool first_vertex = on_camera_segment;
     on_camera_segment = false;
     ++stats.surface_events;
     if (depth >= max_depth_) {
@@ -328,6 +333,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       ++since;
     }
     if (!bsdf.is_delta()) beam_prefix = false;
+    from_xd = light_indirect && first_vertex && bsdf.is_diffuse();
 
     BsdfSample bs;
     const double u_lobe = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
