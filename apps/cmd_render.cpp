@@ -85,7 +85,7 @@ const char* kRenderHelp =
     "                     has point, spot or laser lights, non-diffuse surfaces and a\n"
     "                     scattering medium; photons with such lights and surfaces but no\n"
     "                     scattering medium; else path (femto info prints the choice and why)\n"
-    "  --light-paths N    light tracing: light paths in all (default spp x pixels)\n"
+    "  --light-paths N    light tracing: light paths in all, e.g. 4e7 (default spp x pixels)\n"
     "  --photons N        photons (or beam light paths) per pass (default 200000 photons;\n"
     "                     beam paths: half the pixels, 1000 to 20000); passes = spp\n"
     "  --photon-radius MM photons and beams: initial gather radius R_1 (default 0.5% of the\n"

@@ -141,9 +141,9 @@ bool parse_render_flag(cli::Args& args, const std::string& a, RenderOverrides& o
     else
       args.fail("expected auto, path, light, photons, beams or hybrid", v);
   } else if (a == "--light-paths") {
-    o.light_paths = static_cast<int64_t>(args.int_value(1, 1000000000000LL));
+    o.light_paths = static_cast<int64_t>(args.count_value(1, 1e12));  // 4e7 as well as 40000000
   } else if (a == "--photons") {
-    o.photons_per_pass = static_cast<int64_t>(args.int_value(1, 1000000000LL));
+    o.photons_per_pass = static_cast<int64_t>(args.count_value(1, 1e9));
     if (o.photon_flag.empty()) o.photon_flag = a;
   } else if (a == "--photon-radius") {
     o.photon_radius = args.number_in(0.0, 1e9, true, false, "in (0, 1e9] mm");

@@ -585,10 +585,10 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
   const std::vector<Case> cases = {
       {{}, "hybrid", "auto"},
       {{"--integrator", "path"}, "path", "chosen"},
-      {{"--integrator", "light", "--light-paths", "20000"}, "light", "chosen"},
+      {{"--integrator", "light", "--light-paths", "2e4"}, "light", "chosen"},  // counts as 1e5 too
       {{"--integrator", "photons", "--photons", "3000", "--photon-radius", "2", "--photon-bandwidth", "20"},
        "photons", "chosen"},
-      {{"--integrator", "beams", "--photons", "500"}, "beams", "chosen"},
+      {{"--integrator", "beams", "--photons", "5e2"}, "beams", "chosen"},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
     const fs::path out = tmp.dir / ("out" + std::to_string(i));
