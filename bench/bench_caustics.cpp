@@ -400,7 +400,7 @@ int main(int argc, char** argv) {
           "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S] "
           "[--crop X0,Y0,X1,Y1] [--through-glass]\n  default crop: the caustic on the floor; "
           "--crop 100,88,156,128: the fog under the sphere; --through-glass: the spot aimed at "
-          "the sphere, its cone inside the sphere's silhouette (all light is a caustic's)\n"
+          "the sphere, its cone inside the sphere's silhouette (all of its light enters the glass)\n"
           "       femto-bench-caustics --scene FILE [--ref-passes N] [--size W,H] [--seconds S] "
           "[--threads N]\n"
           "  a scene whose light camera paths cannot reach (data/scenes/tissue_laser.json): "
@@ -427,7 +427,8 @@ int main(int argc, char** argv) {
     if (s.material.type == MaterialDesc::Type::Dielectric) glass = &s;
   if (through_glass) {
     // All of the spot's light through the sphere: aimed at its centre, the cone inside its
-    // silhouette, so every bit of light in the fog and on the walls is a caustic's.
+    // silhouette. Below the sphere the fog and the floor get only light that passed the glass
+    // (and what the fog above it, lit directly, scatters).
     LightDesc& l = spot_desc.lights.front();
     const Vec3 to = glass->center - l.position;
     l.direction = normalize(to);
