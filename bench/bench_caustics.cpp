@@ -308,10 +308,7 @@ int run_scene_file(const std::string& file, const Options& o, int ref_passes, in
     SceneDesc hd = housed_emitter_scene(desc, 2.0);
     const double theta = desc.lights.front().cone_angle_deg * 3.14159265358979323846 / 180.0;
     const int64_t per_pass =
-        desc.integrator.photons.per_pass > 0
-            ? desc.integrator.photons.per_pass
-            : default_beam_paths_per_pass(static_cast<int64_t>(desc.camera.width) *
-                                          desc.camera.height);
+        progressive_settings(scene, IntegratorKind::Beams, desc.integrator.photons).per_pass;
     hd.integrator.photons.per_pass =
         static_cast<int64_t>(static_cast<double>(per_pass) / (0.5 * (1.0 - std::cos(theta))));
     housed.emplace(hd);

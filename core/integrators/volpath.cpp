@@ -208,7 +208,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     const bool found = scene_.geometry().intersect(ray, 0.0, kInf, hit);
     const double s_surf = found ? hit.s : kInf;
     const Medium& med = media[static_cast<size_t>(m)];
-    if (caustic_beams && med.interacts() && depth < max_depth_ && !past_xc && !from_xd)
+    const bool medium_light = depth < max_depth_ && !past_xc && !from_xd;  // light tracing's else
+    if (caustic_beams && med.interacts() && medium_light)
       beams->gather(m, ray, s_surf, beta, t,
                     unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
     if (beam_prefix && med.interacts()) {
@@ -230,7 +231,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
       const ConnectedSegment segment =
           plan_segment(med, ray, s_surf, t, t_dropped, on_camera_segment);
-      if ((segment.active || segment.time_mis) && depth < max_depth_ && !past_xc && !from_xd)
+      if ((segment.active || segment.time_mis) && medium_light)
         estimate_segment(med, m, segment, beta, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every
       // strategy's MIS weight at this segment's vertices sees the same r_aux.
@@ -241,7 +242,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       const DirectionMix mix_main =
           angular ? direction_mix(med, ray.at(ms.main.s), t_main, u_next, depth + 1)
                   : DirectionMix{};
-      if (ms.extra.collided && depth < max_depth_ && !past_xc && !from_xd) {
+      if (ms.extra.collided && medium_light) {
         // The time-uniform collision of MIS: next-event estimation only (the path goes on from
         // the mean-free-path collision).
         const Vec3 x2 = ray.at(ms.extra.s);
