@@ -277,6 +277,44 @@ TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog"
   require_agreement(pt, hy, 12, 0.025);  // a 10% error would be 4 standard errors
 }
 
+// Catches: light scattered in fog and refracted by glass onto a diffuse surface (light -> M S S ->
+// D -> camera) lost or counted twice between the hybrid's light paths and its camera paths. The
+// fog lies above a black plate with a square hole; a glass sphere fills the hole from below. The
+// emitter, just above the plate and far from the hole, cannot light anything under the plate
+// directly: the floor there sees the fog only through the hole, mostly through the glass.
+TEST_CASE("path-only and hybrid agree on fog light refracted onto the floor",
+          "[beams][statistical]") {
+  const SceneDesc d = load_scene_string(R"({
+    "camera": { "type": "perspective", "position": [-80, 15, 90], "look_at": [-5, 0, 0], "fov": 30,
+                "resolution": [16, 12] },
+    "time": { "t_start": 200, "bin_width": 100, "bins": 10 },
+    "media": { "fog": { "type": "homogeneous", "sigma_a": 0.002, "sigma_s": 0.03, "g": 0.3, "eta": 1.0,
+                        "distance_sampling": "mis", "connection_sampling": "mis" } },
+    "shapes": [
+      { "type": "box", "min": [-59, 56, -59], "max": [59, 90, 59], "medium": "fog" },
+      { "type": "quad", "corner": [-60, 0, 60], "edge1": [120, 0, 0], "edge2": [0, 0, -120],
+        "material": { "type": "diffuse", "albedo": 0.7 } },
+      { "type": "quad", "corner": [-60, 55, 60], "edge1": [45, 0, 0], "edge2": [0, 0, -120],
+        "material": { "type": "diffuse", "albedo": 0 } },
+      { "type": "quad", "corner": [5, 55, 60], "edge1": [55, 0, 0], "edge2": [0, 0, -120],
+        "material": { "type": "diffuse", "albedo": 0 } },
+      { "type": "quad", "corner": [-15, 55, 60], "edge1": [20, 0, 0], "edge2": [0, 0, -50],
+        "material": { "type": "diffuse", "albedo": 0 } },
+      { "type": "quad", "corner": [-15, 55, -10], "edge1": [20, 0, 0], "edge2": [0, 0, -50],
+        "material": { "type": "diffuse", "albedo": 0 } },
+      { "type": "sphere", "center": [-5, 42, 0], "radius": 12, "material": { "type": "dielectric", "eta": 1.5 } },
+      { "type": "sphere", "center": [35, 65, 0], "radius": 5, "emission": 64,
+        "material": { "type": "diffuse", "albedo": 0 } }
+    ]
+  })",
+                                        "fog above a hole", ".");
+  const Scene scene(d);
+  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
+  const auto pt = cells(batches(scene, IntegratorKind::Path, 512, 24, 1200), 4, 2);
+  const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 96, 24, 1300, pd), 4, 2);
+  require_agreement(pt, hy, 8, 0.08);  // a 32% error would be 4 standard errors
+}
+
 // Catches: wrong normalisation or timing of caustic beams and photons (camera paths cannot reach
 // light -> glass -> fog from a point light; light tracing splats every fog and floor vertex to
 // the camera, which sees them directly), and fog around the nested glass sphere handled

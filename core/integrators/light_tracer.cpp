@@ -37,14 +37,15 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
   const double eps = scene_.ray_epsilon();
   const bool indirect_only = vertices_ == Vertices::MediumIndirect;
   bool scattered = false;    // a diffuse surface or medium vertex so far
-  bool from_medium = false;  // the previous vertex scattered in a medium
+  bool from_medium = false;  // the last non-specular vertex scattered in a medium
   walk_light_path(scene_, tracker_, rng, max_depth_, t_cut_, stats, [&](const LightVertex& v) {
     if (indirect_only) {
       if (v.kind == LightVertex::Kind::Surface) {
         scattered = scattered || v.bsdf->is_diffuse();
-        // Light scattered in a medium onto a diffuse surface: light -> X* M -> D -> sensor.
+        // Light scattered in a medium onto a diffuse surface, straight or through specular
+        // surfaces: light -> X* M S* -> D -> sensor.
         const bool splat_here = from_medium && v.bsdf->is_diffuse();
-        from_medium = false;
+        if (!v.bsdf->is_delta()) from_medium = false;
         if (!splat_here) return true;
       } else {
         if (v.kind != LightVertex::Kind::Medium) return true;

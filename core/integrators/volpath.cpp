@@ -199,8 +199,9 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   // is a medium vertex: past x_c the path only looks for an emitter hit (the other half of x_c's
   // next-event MIS) and ends at its next vertex.
   bool past_xc = false;
-  // It also owns light -> X* M -> x_c -> camera with x_c a diffuse surface: on the segment leaving
-  // such an x_c the path takes no light scattered in the medium and ends at a collision.
+  // It also owns light -> X* M S* -> x_c -> camera with x_c a diffuse surface: on the segments
+  // leaving such an x_c through specular surfaces the path takes no light scattered in a medium
+  // and ends at a collision.
   bool from_xd = false;
 
   for (;;) {
@@ -309,7 +310,6 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       continue;
     }
     if (past_xc) break;
-    from_xd = false;
     const bool first_vertex = on_camera_segment;
     on_camera_segment = false;
     ++stats.surface_events;
@@ -334,7 +334,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       ++since;
     }
     if (!bsdf.is_delta()) beam_prefix = false;
-    from_xd = light_indirect && first_vertex && bsdf.is_diffuse();
+    from_xd =
+        light_indirect && ((first_vertex && bsdf.is_diffuse()) || (from_xd && bsdf.is_delta()));
 
     BsdfSample bs;
     const double u_lobe = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
