@@ -277,12 +277,13 @@ TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog"
   require_agreement(pt, hy, 12, 0.025);  // a 10% error would be 4 standard errors
 }
 
-// Catches: light scattered in fog and refracted by glass onto a diffuse surface (light -> M S S ->
-// D -> camera) lost or counted twice between the hybrid's light paths and its camera paths. The
-// fog lies above a black plate with a square hole; a glass sphere fills the hole from below. The
-// emitter, just above the plate and far from the hole, cannot light anything under the plate
-// directly: the floor there sees the fog only through the hole, mostly through the glass.
-TEST_CASE("path-only and hybrid agree on fog light refracted onto the floor",
+// Catches: light scattered in fog, or off a diffuse ceiling, and refracted by glass onto a diffuse
+// surface (light -> X* M S S -> D -> camera, light -> X* D S S -> D -> camera) lost or counted
+// twice between the hybrid's light paths and its camera paths. The fog and the ceiling lie above a
+// black plate with a square hole; a glass sphere fills the hole from below. The emitter, just
+// above the plate and far from the hole, cannot light anything under the plate directly: the
+// floor there sees the fog and the ceiling only through the hole, mostly through the glass.
+TEST_CASE("path-only and hybrid agree on fog and ceiling light refracted onto the floor",
           "[beams][statistical]") {
   const SceneDesc d = load_scene_string(R"({
     "camera": { "type": "perspective", "position": [-80, 15, 90], "look_at": [-5, 0, 0], "fov": 30,
@@ -291,7 +292,9 @@ TEST_CASE("path-only and hybrid agree on fog light refracted onto the floor",
     "media": { "fog": { "type": "homogeneous", "sigma_a": 0.002, "sigma_s": 0.03, "g": 0.3, "eta": 1.0,
                         "distance_sampling": "mis", "connection_sampling": "mis" } },
     "shapes": [
-      { "type": "box", "min": [-59, 56, -59], "max": [59, 90, 59], "medium": "fog" },
+      { "type": "box", "min": [-59, 56, -59], "max": [59, 89, 59], "medium": "fog" },
+      { "type": "quad", "corner": [-60, 90, -60], "edge1": [120, 0, 0], "edge2": [0, 0, 120],
+        "material": { "type": "diffuse", "albedo": 0.8 } },
       { "type": "quad", "corner": [-60, 0, 60], "edge1": [120, 0, 0], "edge2": [0, 0, -120],
         "material": { "type": "diffuse", "albedo": 0.7 } },
       { "type": "quad", "corner": [-60, 55, 60], "edge1": [45, 0, 0], "edge2": [0, 0, -120],

@@ -36,21 +36,35 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
   const Camera& cam = scene_.camera();
   const double eps = scene_.ray_epsilon();
   const bool indirect_only = vertices_ == Vertices::MediumIndirect;
-  bool scattered = false;    // a diffuse surface or medium vertex so far
-  bool from_medium = false;  // the last non-specular vertex scattered in a medium
+  bool scattered = false;  // a diffuse surface or medium vertex so far
+  // The latest non-specular vertex, and whether a specular surface came after it.
+  enum class Last { Other, Medium, Diffuse } last = Last::Other;
+  bool specular_since = false;
   walk_light_path(scene_, tracker_, rng, max_depth_, t_cut_, stats, [&](const LightVertex& v) {
     if (indirect_only) {
       if (v.kind == LightVertex::Kind::Surface) {
-        scattered = scattered || v.bsdf->is_diffuse();
+        const bool diffuse = v.bsdf->is_diffuse();
+        scattered = scattered || diffuse;
         // Light scattered in a medium onto a diffuse surface, straight or through specular
-        // surfaces: light -> X* M S* -> D -> sensor.
-        const bool splat_here = from_medium && v.bsdf->is_diffuse();
-        if (!v.bsdf->is_delta()) from_medium = false;
+        // surfaces (light -> X* M S* -> D -> sensor), and light from a diffuse surface through
+        // specular ones (light -> X* D S+ -> D -> sensor): the caustics of what has scattered.
+        const bool splat_here =
+            diffuse && (last == Last::Medium || (last == Last::Diffuse && specular_since));
+        if (v.bsdf->is_delta()) {
+          specular_since = true;
+        } else {
+          last = diffuse ? Last::Diffuse : Last::Other;
+          specular_since = false;
+        }
         if (!splat_here) return true;
       } else {
         if (v.kind != LightVertex::Kind::Medium) return true;
         const bool after_scattering = scattered;
-        if (!v.connection_only) scattered = from_medium = true;
+        if (!v.connection_only) {
+          scattered = true;
+          last = Last::Medium;
+          specular_since = false;
+        }
         // Direct light (light -> M) and caustics (light -> (S|G)+ -> M) are the camera paths'
         // and the beams' share.
         if (!after_scattering) return true;

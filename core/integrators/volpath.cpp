@@ -201,8 +201,9 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   bool past_xc = false;
   // It also owns light -> X* M S* -> x_c -> camera with x_c a diffuse surface: on the segments
   // leaving such an x_c through specular surfaces the path takes no light scattered in a medium
-  // and ends at a collision.
-  bool from_xd = false;
+  // and ends at a collision. And light -> X* D S+ -> x_c: the first diffuse surface reached from
+  // x_c through specular surfaces ends the path.
+  bool from_xd = false, from_xd_specular = false;
 
   for (;;) {
     SurfaceHit hit;
@@ -320,6 +321,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     ++depth;
     const Bsdf bsdf = Bsdf::from_material(
         sh.material, media[static_cast<size_t>(scene_.outside_medium(hit.shape))].eta_at(hit.p));
+    if (from_xd_specular && bsdf.is_diffuse()) break;  // light tracing's (emission above stays)
     const Frame frame(hit.ng);
     const Vec3 wo = frame.to_local(-ray.d);
     const bool wo_outside = front;
@@ -334,6 +336,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       ++since;
     }
     if (!bsdf.is_delta()) beam_prefix = false;
+    from_xd_specular = from_xd && bsdf.is_delta();
     from_xd =
         light_indirect && ((first_vertex && bsdf.is_diffuse()) || (from_xd && bsdf.is_delta()));
 
