@@ -230,9 +230,11 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
   if (opt.integrator == IntegratorKind::Beams || opt.integrator == IntegratorKind::Hybrid)
     m.integrator += beam_pass_bytes(
         (opt.integrator == IntegratorKind::Beams ? 8 : 2) *
-        static_cast<uint64_t>(opt.photons.per_pass > 0
-                                  ? opt.photons.per_pass
-                                  : default_beam_paths_per_pass(static_cast<int64_t>(pixels))));
+        static_cast<uint64_t>(
+            opt.photons.per_pass > 0 ? opt.photons.per_pass
+            : opt.integrator == IntegratorKind::Beams
+                ? default_beam_paths_per_pass(static_cast<int64_t>(pixels))
+                : default_caustic_beam_paths_per_pass(static_cast<int64_t>(pixels))));
   // The hybrid's light-traced indirect fog light: one path per pixel, about 4 splats each.
   if (opt.integrator == IntegratorKind::Hybrid)
     m.integrator += pixels * 4 * (sizeof(Splat) + sizeof(const Splat*)) + (pixels + 1) * 8;

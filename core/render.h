@@ -133,10 +133,19 @@ const char* integrator_name(IntegratorKind kind);
 /// [1000, 20000].
 int64_t default_beam_paths_per_pass(int64_t pixels);
 
-/// `p` with its automatic values filled in for `kind` (Photons or Beams). Photons: 200000 per
-/// pass, R_1 = 0.5% of the scene's bounding-box diagonal, alpha = 4/7, beta_t = 1/3. Beams:
-/// default_beam_paths_per_pass light paths per pass, R_1 = 1% of the diagonal, alpha = 2/3,
-/// beta_t = 1/2. Both: T_1 = one time bin.
+/// The hybrid's caustic beam light paths per pass when the scene sets none: a sixteenth of the
+/// film's pixels, within [1000, 20000].
+int64_t default_caustic_beam_paths_per_pass(int64_t pixels);
+
+/// Width of one pixel at the camera's look-at distance (perspective) or of the film (orthographic).
+double pixel_footprint_mm(const CameraDesc& cam);
+
+/// `p` with its automatic values filled in for `kind`: Photons, Beams, or Hybrid for the
+/// hybrid's caustic beams. Photons: 200000 per pass, R_1 = 0.5% of the scene's bounding-box
+/// diagonal, alpha = 4/7, beta_t = 1/3. Beams: default_beam_paths_per_pass light paths per
+/// pass, R_1 = 1% of the diagonal, alpha = 2/3, beta_t = 1/2. Caustic beams: as beams, but
+/// default_caustic_beam_paths_per_pass paths and R_1 = one pixel's footprint (at most 1% of the
+/// diagonal). All: T_1 = one time bin.
 PhotonDesc progressive_settings(const Scene& scene, IntegratorKind kind, PhotonDesc p);
 
 /// Traces the spp samples of pixel (x, y) into `acc` (reset first) with the scene's temporal

@@ -50,7 +50,8 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const PhotonDesc pd = progressive_settings(
       scene, kind == IntegratorKind::Beams ? IntegratorKind::Beams : IntegratorKind::Photons,
       opt.photons);
-  const PhotonDesc bd = progressive_settings(scene, IntegratorKind::Beams, opt.photons);
+  const PhotonDesc bd = progressive_settings(
+      scene, caustic_beams ? IntegratorKind::Hybrid : IntegratorKind::Beams, opt.photons);
   const double R1 = use_photons ? pd.radius : bd.radius,
                T1 = use_photons ? pd.bandwidth_ps : bd.bandwidth_ps;
   PpmSchedule schedule(pd.radius, pd.bandwidth_ps, pd.alpha, pd.beta_t, use_photons ? 2 : 1);

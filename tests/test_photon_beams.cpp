@@ -422,3 +422,35 @@ TEST_CASE("beams: the default light paths per pass follow the film's pixels", "[
   CHECK(progressive_settings(Scene(d), IntegratorKind::Beams, d.integrator.photons).per_pass ==
         700);
 }
+
+TEST_CASE("hybrid: caustic beams default to a pixel's footprint and fewer paths per pass",
+          "[beams]") {
+  // In the hybrid the caustic beams carry focused light and little of a pass's variance: 1% of
+  // the diagonal blurred the default scene's volumetric caustic, and 20000 paths per pass cost
+  // half of each pass for nothing (docs/PERFORMANCE.md).
+  CHECK(default_caustic_beam_paths_per_pass(256 * 192) == 3072);
+  CHECK(default_caustic_beam_paths_per_pass(64 * 48) == 1000);
+  CHECK(default_caustic_beam_paths_per_pass(1024 * 1024) == 20000);
+  SceneDesc d = load_scene_string(R"({
+    "camera": { "position": [0, 0, 100], "look_at": [0, 0, 0], "fov": 40, "resolution": [256, 192] },
+    "time": { "t_start": 0, "bin_width": 10, "bins": 10 },
+    "media": { "fog": { "type": "homogeneous", "sigma_a": 0.01, "sigma_s": 0.1 } },
+    "shapes": [ { "type": "box", "min": [-300, -300, -300], "max": [300, 300, 300], "medium": "fog" } ],
+    "lights": [ { "type": "point", "position": [0, 0, 0], "intensity": 1 } ]
+  })",
+                                  "fog box", ".");
+  // One pixel at the look-at distance: 100 mm x 2 tan(20 deg) / 192 pixels.
+  const double footprint = 100.0 * 2.0 * std::tan(20.0 * 3.14159265358979323846 / 180.0) / 192.0;
+  CHECK(pixel_footprint_mm(d.camera) == Approx(footprint).epsilon(1e-12));
+  const PhotonDesc hybrid = progressive_settings(Scene(d), IntegratorKind::Hybrid, PhotonDesc{});
+  CHECK(hybrid.radius == Approx(footprint).epsilon(1e-12));
+  CHECK(hybrid.per_pass == 3072);
+  CHECK(hybrid.alpha == Approx(2.0 / 3.0));
+  // `beams` keeps 1% of the diagonal; a small scene keeps it for caustic beams too.
+  const double diag = std::sqrt(3.0) * 600.0;
+  CHECK(progressive_settings(Scene(d), IntegratorKind::Beams, PhotonDesc{}).radius ==
+        Approx(0.01 * diag));
+  d.camera.position = {0, 0, 10000};
+  CHECK(progressive_settings(Scene(d), IntegratorKind::Hybrid, PhotonDesc{}).radius ==
+        Approx(0.01 * diag));
+}
