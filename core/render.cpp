@@ -224,7 +224,11 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
                                : 0;
   m.per_thread = static_cast<uint64_t>(std::max(1, threads)) * (B * 3 * sizeof(double) + held);
   if (opt.integrator == IntegratorKind::Photons || opt.integrator == IntegratorKind::Hybrid)
-    m.integrator = photon_pass_bytes(opt.photons.per_pass > 0 ? opt.photons.per_pass : 200000);
+    m.integrator =
+        photon_pass_bytes(opt.photons.per_pass > 0 ? opt.photons.per_pass
+                          : opt.integrator == IntegratorKind::Hybrid
+                              ? default_hybrid_photons_per_pass(static_cast<int64_t>(pixels))
+                              : 200000);
   // Beams: an estimate (the beams a light path leaves depend on the scene), about 8 per path
   // for all beams; the hybrid's caustic beams end at the path's first scattering, about 2.
   if (opt.integrator == IntegratorKind::Beams || opt.integrator == IntegratorKind::Hybrid)

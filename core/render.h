@@ -137,6 +137,10 @@ int64_t default_beam_paths_per_pass(int64_t pixels);
 /// film's pixels, within [1000, 20000].
 int64_t default_caustic_beam_paths_per_pass(int64_t pixels);
 
+/// The hybrid's photons per pass when the scene sets none: one per pixel of the film, within
+/// [10000, 200000] (the photons integrator keeps 200000).
+int64_t default_hybrid_photons_per_pass(int64_t pixels);
+
 /// Width of one pixel at the camera's look-at distance (perspective) or of the film (orthographic).
 double pixel_footprint_mm(const CameraDesc& cam);
 

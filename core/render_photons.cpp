@@ -42,14 +42,17 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   // Photons are stored at diffuse surfaces only: without one, tracing them would cost a share of
   // every pass and change nothing (a hybrid render of glass in fog).
   const bool trace_surface_photons =
-      use_photons && std::any_of(scene.desc().shapes.begin(), scene.desc().shapes.end(),
-                                 [](const ShapeDesc& sh) {
-                                   return sh.material.type == MaterialDesc::Type::Diffuse;
-                                 });
+      use_photons &&
+      std::any_of(scene.desc().shapes.begin(), scene.desc().shapes.end(), [](const ShapeDesc& sh) {
+        return sh.material.type == MaterialDesc::Type::Diffuse;
+      });
   const bool caustic_beams = kind == IntegratorKind::Hybrid;
+  PhotonDesc photon_opts = opt.photons;
+  if (caustic_beams && photon_opts.per_pass <= 0)
+    photon_opts.per_pass = default_hybrid_photons_per_pass(static_cast<int64_t>(W) * H);
   const PhotonDesc pd = progressive_settings(
       scene, kind == IntegratorKind::Beams ? IntegratorKind::Beams : IntegratorKind::Photons,
-      opt.photons);
+      photon_opts);
   const PhotonDesc bd = progressive_settings(
       scene, caustic_beams ? IntegratorKind::Hybrid : IntegratorKind::Beams, opt.photons);
   const double R1 = use_photons ? pd.radius : bd.radius,

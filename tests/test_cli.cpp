@@ -604,7 +604,8 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     CHECK(contains(integ["why"].get<std::string>(), cases[i].why_part));
     if (cases[i].type == "photons" || cases[i].type == "hybrid") {
       CHECK(integ["passes"] == 2);
-      CHECK(integ["photons_per_pass"].get<int64_t>() == (cases[i].flags.empty() ? 200000 : 3000));
+      // The hybrid's default is one photon per pixel, at least 10000 (40 x 24 pixels here).
+      CHECK(integ["photons_per_pass"].get<int64_t>() == (cases[i].flags.empty() ? 10000 : 3000));
       CHECK(integ["photon_memory_bytes_peak"].get<uint64_t>() > 0);
       if (!cases[i].flags.empty()) {
         CHECK(integ["radius_mm"]["first_pass"].get<double>() == 2.0);

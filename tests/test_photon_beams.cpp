@@ -423,7 +423,7 @@ TEST_CASE("beams: the default light paths per pass follow the film's pixels", "[
         700);
 }
 
-TEST_CASE("hybrid: caustic beams default to a pixel's footprint and fewer paths per pass",
+TEST_CASE("hybrid: caustic beams default to a pixel's footprint, fewer paths and photons per pass",
           "[beams]") {
   // In the hybrid the caustic beams carry focused light and little of a pass's variance: 1% of
   // the diagonal blurred the default scene's volumetric caustic, and 20000 paths per pass cost
@@ -431,6 +431,10 @@ TEST_CASE("hybrid: caustic beams default to a pixel's footprint and fewer paths 
   CHECK(default_caustic_beam_paths_per_pass(256 * 192) == 3072);
   CHECK(default_caustic_beam_paths_per_pass(64 * 48) == 1000);
   CHECK(default_caustic_beam_paths_per_pass(1024 * 1024) == 20000);
+  // Its photons: one per pixel per pass, within [10000, 200000].
+  CHECK(default_hybrid_photons_per_pass(256 * 192) == 49152);
+  CHECK(default_hybrid_photons_per_pass(40 * 24) == 10000);
+  CHECK(default_hybrid_photons_per_pass(1024 * 768) == 200000);
   SceneDesc d = load_scene_string(R"({
     "camera": { "position": [0, 0, 100], "look_at": [0, 0, 0], "fov": 40, "resolution": [256, 192] },
     "time": { "t_start": 0, "bin_width": 10, "bins": 10 },
