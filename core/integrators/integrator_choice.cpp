@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/constants.h"
 #include "core/render.h"
 
 namespace femto {
@@ -97,15 +98,15 @@ int64_t default_hybrid_photons_per_pass(int64_t pixels) {
 double pixel_footprint_mm(const CameraDesc& cam) {
   if (cam.type == CameraDesc::Type::Orthographic) return cam.ortho_width / cam.width;
   const double distance = length(cam.look_at - cam.position);
-  const double half = std::tan(0.5 * cam.fov_deg * 3.14159265358979323846 / 180.0);
+  const double half = std::tan(0.5 * cam.fov_deg * kPi / 180.0);
   return distance * 2.0 * half / cam.height;
 }
 
 PhotonDesc progressive_settings(const Scene& scene, IntegratorKind kind, PhotonDesc p) {
   const bool caustic = kind == IntegratorKind::Hybrid;
   const bool beams = kind == IntegratorKind::Beams || caustic;
-  const double diag = length(scene.geometry().bounds_max() - scene.geometry().bounds_min());
-  const double one_percent = 0.01 * (diag > 0 ? diag : 1.0);
+  const double extent = length(scene.geometry().bounds_max() - scene.geometry().bounds_min());
+  const double diag = extent > 0 ? extent : 1.0;
   const int64_t pixels = static_cast<int64_t>(scene.camera().width()) * scene.camera().height();
   if (p.per_pass <= 0)
     p.per_pass = caustic ? default_caustic_beam_paths_per_pass(pixels)
@@ -115,9 +116,9 @@ PhotonDesc progressive_settings(const Scene& scene, IntegratorKind kind, PhotonD
   // volumetric caustic over 3 pixels, which at 32 passes was most of its error.
   const double footprint = pixel_footprint_mm(scene.desc().camera);
   if (p.radius <= 0)
-    p.radius = caustic && footprint > 0 ? std::min(one_percent, footprint)
-               : beams                  ? one_percent
-                                        : 0.005 * (diag > 0 ? diag : 1.0);
+    p.radius = caustic && footprint > 0 ? std::min(0.01 * diag, footprint)
+               : beams                  ? 0.01 * diag
+                                        : 0.005 * diag;
   if (p.bandwidth_ps <= 0) p.bandwidth_ps = scene.desc().time.bin_width_ps;
   // Photons: bias R^2 + T^2 with R^2 T shrinking balances at beta_t = 1/3 and the MSE is best at
   // alpha = 4/7; beams: bias R^2 + T^2 with R T shrinking balances at 1/2, best alpha 2/3.
