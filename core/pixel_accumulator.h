@@ -1,5 +1,6 @@
 #pragma once
 // One pixel's running sums over its samples, and the per-sample state of the kernel film.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -36,8 +37,26 @@ struct PixelAccumulator {
   std::vector<Held> held;     ///< capacity kept between pixels: no allocation once warm
   std::vector<double> times;  ///< first-pass arrival times, sorted
 
+  /// The bins add_now has written since the last reset (none when touched_last < touched_first).
+  int touched_first = 0, touched_last = -1;
+
   void reset(int n_bins) {
     bins.assign(static_cast<size_t>(n_bins) * 3, 0.0);
+    reset_state();
+  }
+  /// As reset, but zeroes only the bins written since the last reset: for one sample's
+  /// accumulator whose bins are written by add and add_now only.
+  void reset_touched(int n_bins) {
+    if (bins.size() != static_cast<size_t>(n_bins) * 3) {
+      reset(n_bins);
+      return;
+    }
+    if (touched_last >= touched_first)
+      std::fill(bins.begin() + 3 * touched_first, bins.begin() + 3 * (touched_last + 1), 0.0);
+    reset_state();
+  }
+  void reset_state() {
+    touched_first = 0, touched_last = -1;
     before = after = RGB(0.0);
     kernel = hold = false;
     scale = 1.0;
@@ -64,6 +83,14 @@ struct PixelAccumulator {
   void add_now(const TemporalFilter& filter, double t_ps, double sigma_ps, const RGB& value,
                double T) {
     const DepositSplit split = filter.deposit(t_ps, sigma_ps, value, bins.data(), T, floor_ps);
+    if (split.last_bin >= split.first_bin) {
+      if (touched_last < touched_first) {
+        touched_first = split.first_bin, touched_last = split.last_bin;
+      } else {
+        touched_first = std::min(touched_first, split.first_bin);
+        touched_last = std::max(touched_last, split.last_bin);
+      }
+    }
     if (split.before > 0) before += value * split.before;
     if (split.after > 0) after += value * split.after;
   }

@@ -133,8 +133,8 @@ const char* integrator_name(IntegratorKind kind);
 /// [1000, 20000].
 int64_t default_beam_paths_per_pass(int64_t pixels);
 
-/// The hybrid's caustic beam light paths per pass when the scene sets none: a sixteenth of the
-/// film's pixels, within [1000, 20000].
+/// The hybrid's caustic beam light paths per pass when the scene sets none: one per 128 pixels
+/// of the film, within [500, 20000].
 int64_t default_caustic_beam_paths_per_pass(int64_t pixels);
 
 /// The hybrid's photons per pass when the scene sets none: one per pixel of the film, within

@@ -180,7 +180,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                 for (int x = x0; x < x1; ++x) {
                   const size_t p =
                       static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
-                  acc.reset(axis.bins);
+                  acc.reset_touched(axis.bins);  // a full reset per pixel and pass cost ~8%
                   Rng rng = Rng::for_sample(opt.seed, p, static_cast<uint64_t>(pass));
                   double dx, dy;
                   pixel_offset(opt.seed, p, static_cast<uint64_t>(pass), dx, dy);
@@ -189,7 +189,9 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                                    use_photons ? &gather : nullptr,
                                    use_beams ? &beam_gather : nullptr, light_indirect);
                   double* dst = state.sums.data() + p * stride;
-                  for (size_t i = 0; i < nb; ++i) dst[i] += acc.bins[i];
+                  for (size_t i = 3 * static_cast<size_t>(acc.touched_first);
+                       i < 3 * static_cast<size_t>(acc.touched_last + 1); ++i)
+                    dst[i] += acc.bins[i];
                   passes::store_rgb(dst + nb, passes::load_rgb(dst + nb) + acc.before);
                   passes::store_rgb(dst + nb + 3, passes::load_rgb(dst + nb + 3) + acc.after);
                 }

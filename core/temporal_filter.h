@@ -19,6 +19,7 @@ struct DepositSplit {
   double before = 0.0;
   double inside = 0.0;
   double after = 0.0;
+  int first_bin = 0, last_bin = -1;  ///< the bins written (none when last_bin < first_bin)
 };
 
 class TemporalFilter {
@@ -64,6 +65,7 @@ class TemporalFilter {
       if (i >= 0) {
         add(bins, i, value, 1.0);
         split.inside = 1.0;
+        split.first_bin = split.last_bin = i;
       } else if (t_ps < axis_.t_start_ps) {
         split.before = 1.0;
       } else {
@@ -80,6 +82,7 @@ class TemporalFilter {
     if (lo >= hi) return split;
     int i = static_cast<int>((lo - t0) / w);
     const int i_end = std::min(axis_.bins - 1, static_cast<int>((hi - t0) / w));
+    split.first_bin = i, split.last_bin = i_end;
     double cdf_prev = gaussian_cdf((t0 + i * w - t_ps) / sigma_ps);
     for (; i <= i_end; ++i) {
       const double cdf_next = gaussian_cdf((t0 + (i + 1) * w - t_ps) / sigma_ps);
@@ -111,6 +114,7 @@ class TemporalFilter {
     if (lo >= hi) return split;
     int i = static_cast<int>((lo - t0) / w);
     const int i_end = std::min(axis_.bins - 1, static_cast<int>((hi - t0) / w));
+    split.first_bin = i, split.last_bin = i_end;
     double cdf_prev = G(t0 + i * w);
     for (; i <= i_end; ++i) {
       const double cdf_next = G(t0 + (i + 1) * w);

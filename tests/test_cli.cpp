@@ -620,8 +620,8 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     if (cases[i].type == "light") CHECK(integ["light_paths"] == 20000);
     if (cases[i].type == "hybrid") {
       CHECK(integ["caustic_beams"]["alpha"].get<double>() == Approx(2.0 / 3.0));
-      // Half a beam path per pixel of the 40 x 24 film, raised to the floor of 1000.
-      CHECK(integ["caustic_beams"]["light_paths_per_pass"] == 1000);
+      // One beam path per 128 pixels of the 40 x 24 film, raised to the floor of 500.
+      CHECK(integ["caustic_beams"]["light_paths_per_pass"] == 500);
     }
     if (cases[i].type != "path" && cases[i].type != "light") {
       // Each part of a pass is timed where it runs (none where it does not), within the render.

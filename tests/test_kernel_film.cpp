@@ -8,6 +8,7 @@
 #include <cstring>
 #include <vector>
 
+#include "core/pixel_accumulator.h"
 #include "core/reconstruction.h"
 #include "core/rng.h"
 #include "core/temporal_filter.h"
@@ -298,5 +299,35 @@ TEST_CASE("kernel film keeps the histogram's energy and is deterministic", "[ker
     CHECK(hs.g > 0);
     CHECK(std::abs(ks.g - hs.g) < 1e-5 * hs.g);
     CHECK(std::memcmp(k1.film.transient(), h.film.transient(), n * sizeof(float)) != 0);
+  }
+}
+
+// Catches: a touched range that misses a bin a deposit wrote (histogram, Gaussian pulse or
+// kernel), which would leave light from one sample in the next (the hybrid's camera loop zeroes
+// and reads only that range), or a reset that leaves bins non-zero.
+TEST_CASE("a pixel accumulator knows which bins its deposits wrote", "[kernel_film]") {
+  const TimeAxis axis{100.0, 10.0, 40};
+  Rng rng(7, 3);
+  PixelAccumulator acc;
+  acc.reset(axis.bins);
+  for (int sample = 0; sample < 300; ++sample) {
+    const int kind = sample % 3;  // histogram delta, Gaussian pulse, Epanechnikov kernel
+    const TemporalFilter filter(
+        axis, kind == 2 ? TemporalFilter::Kind::Kernel : TemporalFilter::Kind::Histogram,
+        TemporalKernel::Epanechnikov);
+    const int deposits = 1 + static_cast<int>(4 * rng.uniform());
+    for (int k = 0; k < deposits; ++k) {
+      const double t = 60.0 + 420.0 * rng.uniform();  // some before or after the window
+      const double sigma = kind == 1 ? 25.0 * rng.uniform() : 0.0;
+      acc.add_now(filter, t, sigma, RGB(1.0, 2.0, 3.0), kind == 2 ? 30.0 * rng.uniform() : 0.0);
+    }
+    for (int i = 0; i < axis.bins; ++i) {
+      const bool inside = i >= acc.touched_first && i <= acc.touched_last;
+      if (!inside && acc.bins[3 * static_cast<size_t>(i)] != 0.0)
+        FAIL("sample " << sample << ": bin " << i << " written outside the touched range");
+    }
+    acc.reset_touched(axis.bins);
+    CHECK(std::all_of(acc.bins.begin(), acc.bins.end(), [](double v) { return v == 0.0; }));
+    CHECK(acc.touched_last < acc.touched_first);
   }
 }

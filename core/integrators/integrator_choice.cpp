@@ -85,8 +85,9 @@ int64_t default_beam_paths_per_pass(int64_t pixels) {
 int64_t default_caustic_beam_paths_per_pass(int64_t pixels) {
   // The hybrid's caustic beams are gathered along every camera segment in a medium, and a pass's
   // other parts (camera paths, light paths) decide most of its variance: in the default scene
-  // 20000 paths per pass took half of each pass and lowered no error (docs/PERFORMANCE.md).
-  return std::clamp<int64_t>(pixels / 16, 1000, 20000);
+  // 20000 paths per pass took half of each pass and lowered no error, and 3072 still cost a fifth
+  // of a pass of the through-glass scene against 500 at the same error (docs/PERFORMANCE.md).
+  return std::clamp<int64_t>(pixels / 128, 500, 20000);
 }
 
 int64_t default_hybrid_photons_per_pass(int64_t pixels) {

@@ -19,7 +19,7 @@ namespace {
 constexpr int64_t kChunk = 256;  // light paths per task: the unit of deterministic ordering
 /// Beam streams are keyed apart from camera pixels and photons.
 constexpr uint64_t kBeamStream = 0x6000000000000000ULL;
-constexpr uint32_t kLeafSize = 4;
+constexpr uint32_t kLeafSize = 2;
 
 }  // namespace
 
@@ -36,6 +36,74 @@ struct BuildItem {
   float lo[3], hi[3];
   float centre[3];
 };
+
+// Binned surface-area heuristic: camera segments are long and cross the beams' bundles, so the
+// expected number of boxes a segment meets (proportional to their surface area) is what a split
+// should make small; a median split of converging beams gives children that overlap.
+constexpr int kSahBins = 8;
+// Depth up to which splits follow the heuristic; median splits below it add at most
+// log2(pieces) levels, so trees stay within BeamBvh::query's stack of 64.
+constexpr uint32_t kSahDepth = 24;
+constexpr uint32_t kSahMinCount = 256;
+
+int sah_bin(float centre, float lo, float scale) {
+  return std::clamp(static_cast<int>((centre - lo) * scale), 0, kSahBins - 1);
+}
+
+struct Box {
+  float lo[3] = {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
+                 std::numeric_limits<float>::infinity()};
+  float hi[3] = {-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                 -std::numeric_limits<float>::infinity()};
+  void grow(const float l[3], const float h[3]) {
+    for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], l[c]), hi[c] = std::max(hi[c], h[c]);
+  }
+  double half_area() const {
+    const double x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+    return x * y + y * z + z * x;
+  }
+};
+
+struct SahSplit {
+  int axis = -1;  ///< -1: no split separates the centres
+  int bin = 0;    ///< bins 0..bin go left
+};
+
+SahSplit sah_split(const std::vector<BuildItem>& items, const uint32_t* order, uint32_t count,
+                   const float clo[3], const float ext[3]) {
+  SahSplit best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (!(ext[a] > 0)) continue;
+    const float scale = kSahBins / ext[a];
+    Box box[kSahBins];
+    uint32_t n[kSahBins] = {};
+    for (uint32_t k = 0; k < count; ++k) {
+      const BuildItem& it = items[order[k]];
+      const int b = sah_bin(it.centre[a], clo[a], scale);
+      box[b].grow(it.lo, it.hi);
+      ++n[b];
+    }
+    double right_cost[kSahBins];  // area x count of bins b + 1 .. end
+    Box acc;
+    uint32_t acc_n = 0;
+    for (int b = kSahBins - 1; b > 0; --b) {
+      acc.grow(box[b].lo, box[b].hi);
+      acc_n += n[b];
+      right_cost[b - 1] = acc_n > 0 ? acc.half_area() * acc_n : 0.0;
+    }
+    Box left;
+    uint32_t left_n = 0;
+    for (int b = 0; b + 1 < kSahBins; ++b) {
+      left.grow(box[b].lo, box[b].hi);
+      left_n += n[b];
+      if (left_n == 0 || left_n == count) continue;
+      const double cost = left.half_area() * left_n + right_cost[b];
+      if (cost < best_cost) best_cost = cost, best.axis = a, best.bin = b;
+    }
+  }
+  return best;
+}
 }  // namespace
 
 void BeamBvh::build(std::vector<Beam> beams, double radius) {
@@ -66,17 +134,18 @@ void BeamBvh::build(std::vector<Beam> beams, double radius) {
       v_prev = v1;
     }
   }
-  // Median splits on the widest axis of the centres, over an index permutation; ties by index
-  // give the same tree on every run.
+  // Splits by the binned surface-area heuristic (median splits of the widest axis of the centres
+  // where it finds none, and deep in the tree), over an index permutation: the same tree on every
+  // run. A node's children are adjacent.
   std::vector<uint32_t> order(pieces_.size());
   for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
   nodes_.reserve(2 * pieces_.size() / kLeafSize + 2);
   struct Task {
-    uint32_t first, count, node;
+    uint32_t first, count, node, depth;
   };
   std::vector<Task> todo;
   nodes_.push_back({});
-  todo.push_back({0, static_cast<uint32_t>(order.size()), 0});
+  todo.push_back({0, static_cast<uint32_t>(order.size()), 0, 0});
   while (!todo.empty()) {
     const Task t = todo.back();
     todo.pop_back();
@@ -97,26 +166,40 @@ void BeamBvh::build(std::vector<Beam> beams, double radius) {
     Node& node = nodes_[t.node];
     for (int c = 0; c < 3; ++c) node.lo[c] = blo[c], node.hi[c] = bhi[c];
     const float ext[3] = {chi[0] - clo[0], chi[1] - clo[1], chi[2] - clo[2]};
-    const int axis = ext[0] >= ext[1] && ext[0] >= ext[2] ? 0 : (ext[1] >= ext[2] ? 1 : 2);
-    if (t.count <= kLeafSize || !(ext[axis] > 0)) {
+    const int widest = ext[0] >= ext[1] && ext[0] >= ext[2] ? 0 : (ext[1] >= ext[2] ? 1 : 2);
+    if (t.count <= kLeafSize || !(ext[widest] > 0)) {
       node.first = t.first;
       node.count = t.count;
       continue;
     }
-    const uint32_t half = t.count / 2;
-    std::nth_element(order.begin() + t.first, order.begin() + t.first + half,
-                     order.begin() + t.first + t.count, [&](uint32_t a, uint32_t b) {
-                       const float ca = items[a].centre[axis], cb = items[b].centre[axis];
-                       return ca < cb || (ca == cb && a < b);
-                     });
-    const auto left = static_cast<uint32_t>(nodes_.size());
+    // Below kSahDepth median splits only: the depth stays within the query's stack.
+    const SahSplit split = t.depth < kSahDepth && t.count > kSahMinCount
+                               ? sah_split(items, order.data() + t.first, t.count, clo, ext)
+                               : SahSplit{};
+    uint32_t half;
+    if (split.axis >= 0) {
+      // Pieces whose centre falls in bins 0..split.bin go left (a deterministic partition).
+      const int a = split.axis;
+      const float scale = kSahBins / ext[a];
+      auto* first = order.data() + t.first;
+      auto* mid = std::partition(first, first + t.count, [&](uint32_t i) {
+        return sah_bin(items[i].centre[a], clo[a], scale) <= split.bin;
+      });
+      half = static_cast<uint32_t>(mid - first);
+    } else {  // no bin boundary separates the centres: split at the median of the widest axis
+      half = t.count / 2;
+      std::nth_element(order.begin() + t.first, order.begin() + t.first + half,
+                       order.begin() + t.first + t.count, [&](uint32_t a, uint32_t b) {
+                         const float ca = items[a].centre[widest], cb = items[b].centre[widest];
+                         return ca < cb || (ca == cb && a < b);
+                       });
+    }
+    const auto left = static_cast<uint32_t>(nodes_.size()), right = left + 1;
     nodes_.push_back({});
-    const auto right = static_cast<uint32_t>(nodes_.size());
     nodes_.push_back({});
-    nodes_[t.node].left = left;
-    nodes_[t.node].right = right;
-    todo.push_back({t.first + half, t.count - half, right});
-    todo.push_back({t.first, half, left});
+    nodes_[t.node].first = left;
+    todo.push_back({t.first + half, t.count - half, right, t.depth + 1});
+    todo.push_back({t.first, half, left, t.depth + 1});
   }
   std::vector<Piece> sorted(pieces_.size());
   for (size_t i = 0; i < order.size(); ++i) sorted[i] = pieces_[order[i]];

@@ -53,10 +53,11 @@ class BeamBvh {
   uint64_t memory_bytes() const;
 
  private:
+  /// 32 bytes, two to a cache line (the traversal waits on node loads).
   struct Node {
     float lo[3], hi[3];
-    uint32_t first = 0, count = 0;  ///< leaf: pieces [first, first + count); inner: count = 0
-    uint32_t left = 0, right = 0;   ///< inner: children
+    /// Leaf: pieces [first, first + count). Inner (count = 0): children first and first + 1.
+    uint32_t first = 0, count = 0;
   };
   static bool hits(const Node& n, const float o[3], const float inv_d[3], float t_max);
   std::vector<Beam> beams_;
@@ -116,8 +117,8 @@ void BeamBvh::query(const Vec3& o, const Vec3& d, double t_max, F&& f) const {
       for (uint32_t i = n.first; i < n.first + n.count; ++i)
         f(beams_[pieces_[i].beam], pieces_[i]);
     } else if (top + 2 <= 64) {
-      stack[top++] = n.right;
-      stack[top++] = n.left;
+      stack[top++] = n.first + 1;
+      stack[top++] = n.first;
     }
   }
 }
