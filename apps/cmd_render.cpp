@@ -394,6 +394,7 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   } abort_reset;
   OutputOptions staged = out;
   staged.dir = folder.staging();
+  staged.threads = opt.threads;
 
   if (comm.single()) opt.stop = &stop_signals::requested();  // across ranks a signal aborts
   if (resumed) opt.resume = &resumed->state;

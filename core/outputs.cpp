@@ -1,10 +1,15 @@
 #include "core/outputs.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/io/atomic_file.h"
@@ -108,21 +113,29 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
   }
   files.push_back("render.json");
   info["outputs"] = files;
-  // Every file with its size and SHA-256 (render.json itself excepted), frames one by one.
-  nlohmann::json listing = nlohmann::json::array();
-  auto list = [&](const std::string& name) {
-    const std::string path = path_of(name);
-    listing.push_back({{"name", name}, {"bytes", fs::file_size(path)}, {"sha256", sha256_file(path)}});
-  };
+  // Every file with its size and SHA-256 (render.json itself excepted), frames one by one. The
+  // files are hashed in parallel: one thread hashing a default render's outputs took 6% of a
+  // 16-pass hybrid render.
+  std::vector<std::string> names;
   for (const auto& f : files) {
     const std::string name = f.get<std::string>();
     if (name == "render.json") continue;
     if (name == "frames/") {
-      for (int t = 0; t < T; ++t) list(frame_file_name(axis, t));
+      for (int t = 0; t < T; ++t) names.push_back(frame_file_name(axis, t));
     } else {
-      list(name);
+      names.push_back(name);
     }
   }
+  std::vector<std::string> digests(names.size());
+  tbb::task_arena arena(opt.threads > 0 ? opt.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(size_t{0}, names.size(),
+                      [&](size_t i) { digests[i] = sha256_file(path_of(names[i])); });
+  });
+  nlohmann::json listing = nlohmann::json::array();
+  for (size_t i = 0; i < names.size(); ++i)
+    listing.push_back(
+        {{"name", names[i]}, {"bytes", fs::file_size(path_of(names[i]))}, {"sha256", digests[i]}});
   info["files"] = listing;
   if (info.contains("memory") && info["memory"].is_object()) info["memory"]["peak_rss_bytes"] = peak_rss_bytes();
   write_text_atomically(path_of("render.json"), info.dump(2) + "\n");

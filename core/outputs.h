@@ -22,6 +22,7 @@ struct OutputOptions {
   bool video = false;       ///< transient.mp4
   VideoSpec video_spec;     ///< fps and encoder (the size is the film's, enlarged)
   VideoBackend video_backend = default_video_backend();
+  int threads = 0;  ///< threads that hash the files (0: all cores), as the render's --threads
 };
 
 /// File name of frame t inside the output folder, e.g. "frames/frame_0007_12.500ps.exr".
