@@ -137,9 +137,13 @@ int64_t default_beam_paths_per_pass(int64_t pixels);
 /// of the film, within [500, 20000].
 int64_t default_caustic_beam_paths_per_pass(int64_t pixels);
 
-/// The hybrid's photons per pass when the scene sets none: one per pixel of the film, within
-/// [10000, 200000] (the photons integrator keeps 200000).
+/// The hybrid's photons per pass when the scene sets none: one per two pixels of the film,
+/// within [10000, 200000] (the photons integrator keeps 200000).
 int64_t default_hybrid_photons_per_pass(int64_t pixels);
+
+/// The hybrid's light paths per pass for light tracing's share (docs/ARCHITECTURE.md, "Path-space
+/// partition"): one per two pixels of the film.
+int64_t default_hybrid_light_paths_per_pass(int64_t pixels);
 
 /// Width of one pixel at the camera's look-at distance (perspective) or of the film (orthographic).
 double pixel_footprint_mm(const CameraDesc& cam);

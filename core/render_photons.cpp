@@ -61,10 +61,10 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   PpmSchedule beam_schedule(bd.radius, bd.bandwidth_ps, bd.alpha, bd.beta_t, 1);
   const MediumTracker tracker(scene);
   // Hybrid: light paths splatted from their medium vertices once they have scattered (off a
-  // diffuse surface or in a medium), which camera paths then leave out: one light path per pixel
-  // per pass (docs/ARCHITECTURE.md, "Path-space partition").
+  // diffuse surface or in a medium), which camera paths then leave out: one light path per two
+  // pixels per pass (docs/ARCHITECTURE.md, "Path-space partition").
   const bool light_indirect = caustic_beams;
-  const int64_t indirect_paths = static_cast<int64_t>(W) * H;
+  const int64_t indirect_paths = default_hybrid_light_paths_per_pass(static_cast<int64_t>(W) * H);
   // Photon times include the emission offset: the window end plus the widest pulse spread.
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
 

@@ -604,7 +604,7 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     CHECK(contains(integ["why"].get<std::string>(), cases[i].why_part));
     if (cases[i].type == "photons" || cases[i].type == "hybrid") {
       CHECK(integ["passes"] == 2);
-      // The hybrid's default is one photon per pixel, at least 10000 (40 x 24 pixels here).
+      // The hybrid's default is one photon per two pixels, at least 10000 (40 x 24 pixels here).
       CHECK(integ["photons_per_pass"].get<int64_t>() == (cases[i].flags.empty() ? 10000 : 3000));
       CHECK(integ["photon_memory_bytes_peak"].get<uint64_t>() > 0);
       if (!cases[i].flags.empty()) {
@@ -662,8 +662,9 @@ TEST_CASE("cli: the hybrid traces no photons without a diffuse surface", "[cli]"
   const json info = json::parse(read_text(out / "render.json"));
   CHECK(info["timing"]["pass_seconds"]["photons"].get<double>() == 0.0);
   CHECK(info["timing"]["pass_seconds"]["beams"].get<double>() > 0.0);
-  // Per pass: 500 beam light paths and one indirect light path per pixel (40 x 24), no photons.
-  CHECK(info["counters"]["light_paths"].get<uint64_t>() == 2u * (500u + 40u * 24u));
+  // Per pass: 500 beam light paths and one indirect light path per two pixels (40 x 24), no
+  // photons.
+  CHECK(info["counters"]["light_paths"].get<uint64_t>() == 2u * (500u + 40u * 24u / 2u));
   CHECK(info["counters"]["photons_stored"].get<uint64_t>() == 0u);
 }
 

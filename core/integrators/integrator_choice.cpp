@@ -92,8 +92,16 @@ int64_t default_caustic_beam_paths_per_pass(int64_t pixels) {
 
 int64_t default_hybrid_photons_per_pass(int64_t pixels) {
   // In the hybrid, 200000 photons per pass took a third of each pass in the default scene and
-  // lowered no error: its caustic's noise is the camera's pixel sampling of the sharp focus.
-  return std::clamp<int64_t>(pixels, 10000, 200000);
+  // lowered no error: its caustic's noise is the camera's pixel sampling of the sharp focus; so
+  // did 49152 after the other parts of a pass became cheaper (10000 still gave the same errors).
+  return std::clamp<int64_t>(pixels / 2, 10000, 200000);
+}
+
+int64_t default_hybrid_light_paths_per_pass(int64_t pixels) {
+  // Where light tracing carries most of the error (fog under a glass sphere) half a path per
+  // pixel gave the same error per second as one, and where camera paths do (the floor caustic)
+  // 1.35x more; a quarter lost 0.78x in the fog (docs/PERFORMANCE.md).
+  return std::max<int64_t>(1, pixels / 2);
 }
 
 double pixel_footprint_mm(const CameraDesc& cam) {
