@@ -44,6 +44,7 @@ constexpr int kSahBins = 8;
 // Depth up to which splits follow the heuristic; median splits below it add at most
 // log2(pieces) levels, so trees stay within BeamBvh::query's stack of 64.
 constexpr uint32_t kSahDepth = 24;
+// Nodes of fewer pieces split at the median: binning them cost more build time than it saved.
 constexpr uint32_t kSahMinCount = 256;
 
 int sah_bin(float centre, float lo, float scale) {
@@ -135,8 +136,8 @@ void BeamBvh::build(std::vector<Beam> beams, double radius) {
     }
   }
   // Splits by the binned surface-area heuristic (median splits of the widest axis of the centres
-  // where it finds none, and deep in the tree), over an index permutation: the same tree on every
-  // run. A node's children are adjacent.
+  // in small nodes, deep in the tree and where it finds none), over an index permutation: the
+  // same tree on every run. A node's children are adjacent.
   std::vector<uint32_t> order(pieces_.size());
   for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
   nodes_.reserve(2 * pieces_.size() / kLeafSize + 2);
