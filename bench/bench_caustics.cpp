@@ -33,6 +33,9 @@ struct Options {
   int threads = 2;
   int x0 = 96, y0 = 136, x1 = 160, y1 = 180;  ///< crop (pixels, end exclusive)
   uint64_t seed = 7;
+  /// Renders per estimator (seeds seed, seed + 1, ...; default-scene mode): errors are the RMS
+  /// over them, seconds their mean. Heavy-tailed estimators need several for a steady figure.
+  int seeds = 1;
 };
 
 double now_s() {
@@ -377,7 +380,13 @@ int main(int argc, char** argv) {
       o.threads = std::atoi(next().c_str());
     else if (a == "--seed")
       o.seed = std::strtoull(next().c_str(), nullptr, 10);
-    else if (a == "--scene")
+    else if (a == "--seeds") {
+      o.seeds = std::atoi(next().c_str());
+      if (o.seeds < 1 || o.seeds > 99) {  // the references use seeds from seed + 100 on
+        std::fprintf(stderr, "femto-bench-caustics: --seeds must be 1 to 99\n");
+        return 2;
+      }
+    } else if (a == "--scene")
       scene_file = next();
     else if (a == "--through-glass")
       through_glass = true;
@@ -396,10 +405,11 @@ int main(int argc, char** argv) {
     } else if (a == "--help") {
       std::printf(
           "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S] "
-          "[--crop X0,Y0,X1,Y1] [--through-glass]\n  default crop: the caustic on the floor; "
+          "[--crop X0,Y0,X1,Y1] [--through-glass] [--seeds K]\n  default crop: the caustic on the "
+          "floor; "
           "--crop 100,88,156,128: the fog under the sphere; --through-glass: the spot aimed at "
           "the sphere, its cone inside the sphere's silhouette (all of its light enters the "
-          "glass)\n"
+          "glass); --seeds K: K renders per estimator, errors as their RMS (1 to 99)\n"
           "       femto-bench-caustics --scene FILE [--ref-passes N] [--size W,H] [--seconds S] "
           "[--threads N]\n"
           "  a scene whose light camera paths cannot reach (data/scenes/tissue_laser.json): "
@@ -417,9 +427,9 @@ int main(int argc, char** argv) {
     return run_scene_file(scene_file, o, ref_passes, width, height);
   }
   std::printf(
-      "femto-bench-caustics: CPU %s, %d threads, %.0f s per estimator, references of %.3g light "
-      "paths\n",
-      cpu_model().c_str(), o.threads, o.seconds, o.ref_paths);
+      "femto-bench-caustics: CPU %s, %d threads, %.0f s per estimator and render, %d render(s) "
+      "each, references of %.3g light paths\n",
+      cpu_model().c_str(), o.threads, o.seconds, o.seeds, o.ref_paths);
   SceneDesc spot_desc = load_scene_string(default_scene_json(), "<default scene>", ".");
   const ShapeDesc* glass = nullptr;
   for (const ShapeDesc& s : spot_desc.shapes)
@@ -489,10 +499,23 @@ int main(int argc, char** argv) {
   };
   for (const Case& c : cases) {
     const int64_t work = work_for_budget(*c.scene, c.kind, o);
-    t0 = now_s();
-    const RenderResult r = run(*c.scene, c.kind, work, o, o.seed);
-    const double secs = now_s() - t0;
-    const Errors e = errors(r.film.steady(), r.film.transient(), *c.ref, px);
+    // K renders: squared errors and seconds averaged (errors with the reference's own variance
+    // taken out, per render, for the corrected figures).
+    double sq_steady = 0, sq_transient = 0, sq_steady_c = 0, sq_transient_c = 0, secs = 0;
+    for (int k = 0; k < o.seeds; ++k) {
+      t0 = now_s();
+      const RenderResult r = run(*c.scene, c.kind, work, o, o.seed + static_cast<uint64_t>(k));
+      secs += now_s() - t0;
+      const Errors ek = errors(r.film.steady(), r.film.transient(), *c.ref, px);
+      sq_steady += ek.steady * ek.steady;
+      sq_transient += ek.transient * ek.transient;
+      const double cs = without_ref(ek.steady, c.ref->own.steady),
+                   ct = without_ref(ek.transient, c.ref->own.transient);
+      sq_steady_c += cs * cs;
+      sq_transient_c += ct * ct;
+    }
+    secs /= o.seeds;
+    const Errors e{std::sqrt(sq_steady / o.seeds), std::sqrt(sq_transient / o.seeds)};
     // Variance falls as 1 / time: scale each error to the budget before taking ratios.
     const double scale = std::sqrt(secs / o.seconds);
     const double steady_eq = e.steady * scale, transient_eq = e.transient * scale;
@@ -503,8 +526,8 @@ int main(int argc, char** argv) {
                 base_transient / transient_eq);
     std::printf("%-32s %14s %9s %13s %16s steady %.4f (%5.1fx)\n", "", "", "", "", "", steady_eq,
                 base_steady / steady_eq);
-    const double steady_c = without_ref(e.steady, c.ref->own.steady) * scale,
-                 transient_c = without_ref(e.transient, c.ref->own.transient) * scale;
+    const double steady_c = std::sqrt(sq_steady_c / o.seeds) * scale,
+                 transient_c = std::sqrt(sq_transient_c / o.seeds) * scale;
     if (&c == &cases[0]) base_steady_c = steady_c, base_transient_c = transient_c;
     std::printf(
         "%-32s %14s %9s %13s %16s without the reference's own error: steady %.4f (%5.1fx), "
