@@ -38,7 +38,7 @@ struct PixelAccumulator {
   std::vector<double> times;  ///< first-pass arrival times, sorted
 
   /// The bins add_now has written since the last reset (none when touched_last < touched_first).
-  int touched_first = 0, touched_last = -1;
+  int touched_first = std::numeric_limits<int>::max(), touched_last = -1;
 
   void reset(int n_bins) {
     bins.assign(static_cast<size_t>(n_bins) * 3, 0.0);
@@ -56,7 +56,7 @@ struct PixelAccumulator {
     reset_state();
   }
   void reset_state() {
-    touched_first = 0, touched_last = -1;
+    touched_first = std::numeric_limits<int>::max(), touched_last = -1;
     before = after = RGB(0.0);
     kernel = hold = false;
     scale = 1.0;
@@ -84,12 +84,8 @@ struct PixelAccumulator {
                double T) {
     const DepositSplit split = filter.deposit(t_ps, sigma_ps, value, bins.data(), T, floor_ps);
     if (split.last_bin >= split.first_bin) {
-      if (touched_last < touched_first) {
-        touched_first = split.first_bin, touched_last = split.last_bin;
-      } else {
-        touched_first = std::min(touched_first, split.first_bin);
-        touched_last = std::max(touched_last, split.last_bin);
-      }
+      touched_first = std::min(touched_first, split.first_bin);
+      touched_last = std::max(touched_last, split.last_bin);
     }
     if (split.before > 0) before += value * split.before;
     if (split.after > 0) after += value * split.after;
