@@ -90,7 +90,7 @@ const char* kRenderHelp =
     "                     beam paths: half the pixels, 1000 to 20000; hybrid: one photon per\n"
     "                     two pixels, 10000 to 200000, and caustic beam paths one per 128\n"
     "                     pixels, 500 to 20000; its light paths for light tracing's share,\n"
-    "                     one per two pixels, are not set by this flag); passes = spp\n"
+    "                     one per four pixels, are not set by this flag); passes = spp\n"
     "  --photon-radius MM photons and beams: initial gather radius R_1 (default 0.5% of the\n"
     "                     bounding-box diagonal of the scene for photons, 1% for beams, one\n"
     "                     pixel's width at the look_at distance for the hybrid's caustic beams)\n"

@@ -1,5 +1,6 @@
 #pragma once
 // Pinhole perspective and orthographic cameras. Pixel (0,0) is the top-left corner.
+#include <algorithm>
 #include <cmath>
 
 #include "core/constants.h"
@@ -65,6 +66,31 @@ class Camera {
     return true;
   }
 
+  /// The part [s0, s1] of the ray o + s d, s in [s0, s1] on entry, that a perspective camera's
+  /// film sees (between its four side planes); false if none, or for an orthographic camera.
+  bool frustum_interval(const Vec3& o, const Vec3& d, double& s0, double& s1) const {
+    if (desc_.type != CameraDesc::Type::Perspective) return false;
+    const Vec3 v = o - desc_.position;
+    const double z0 = dot(v, forward_), zd = dot(d, forward_);
+    // Each side plane keeps a + b s >= 0.
+    const double a[4] = {half_w_ * z0 - dot(v, right_), half_w_ * z0 + dot(v, right_),
+                         half_h_ * z0 - dot(v, up_), half_h_ * z0 + dot(v, up_)};
+    const double b[4] = {half_w_ * zd - dot(d, right_), half_w_ * zd + dot(d, right_),
+                         half_h_ * zd - dot(d, up_), half_h_ * zd + dot(d, up_)};
+    for (int k = 0; k < 4; ++k) {
+      if (b[k] == 0) {
+        if (a[k] < 0) return false;
+      } else if (b[k] > 0) {
+        s0 = std::max(s0, -a[k] / b[k]);
+      } else {
+        s1 = std::min(s1, -a[k] / b[k]);
+      }
+    }
+    return s0 < s1;
+  }
+
+  const Vec3& position() const { return desc_.position; }
+  bool perspective() const { return desc_.type == CameraDesc::Type::Perspective; }
   int width() const { return desc_.width; }
   int height() const { return desc_.height; }
 

@@ -142,7 +142,7 @@ int64_t default_caustic_beam_paths_per_pass(int64_t pixels);
 int64_t default_hybrid_photons_per_pass(int64_t pixels);
 
 /// The hybrid's light paths per pass for light tracing's share (docs/ARCHITECTURE.md, "Path-space
-/// partition"): one per two pixels of the film.
+/// partition"): one per four pixels of the film.
 int64_t default_hybrid_light_paths_per_pass(int64_t pixels);
 
 /// Width of one pixel at the camera's look-at distance (perspective) or of the film (orthographic).

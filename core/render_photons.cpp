@@ -61,7 +61,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   PpmSchedule beam_schedule(bd.radius, bd.bandwidth_ps, bd.alpha, bd.beta_t, 1);
   const MediumTracker tracker(scene);
   // Hybrid: light paths splatted from their medium vertices once they have scattered (off a
-  // diffuse surface or in a medium), which camera paths then leave out: one light path per two
+  // diffuse surface or in a medium), which camera paths then leave out: one light path per four
   // pixels per pass (docs/ARCHITECTURE.md, "Path-space partition").
   const bool light_indirect = caustic_beams;
   const int64_t indirect_paths = default_hybrid_light_paths_per_pass(static_cast<int64_t>(W) * H);

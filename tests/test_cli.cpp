@@ -662,9 +662,9 @@ TEST_CASE("cli: the hybrid traces no photons without a diffuse surface", "[cli]"
   const json info = json::parse(read_text(out / "render.json"));
   CHECK(info["timing"]["pass_seconds"]["photons"].get<double>() == 0.0);
   CHECK(info["timing"]["pass_seconds"]["beams"].get<double>() > 0.0);
-  // Per pass: 500 beam light paths and one indirect light path per two pixels (40 x 24), no
+  // Per pass: 500 beam light paths and one indirect light path per four pixels (40 x 24), no
   // photons.
-  CHECK(info["counters"]["light_paths"].get<uint64_t>() == 2u * (500u + 40u * 24u / 2u));
+  CHECK(info["counters"]["light_paths"].get<uint64_t>() == 2u * (500u + 40u * 24u / 4u));
   CHECK(info["counters"]["photons_stored"].get<uint64_t>() == 0u);
 }
 

@@ -436,11 +436,11 @@ TEST_CASE("hybrid: caustic beams default to a pixel's footprint, fewer paths and
   CHECK(default_caustic_beam_paths_per_pass(1024 * 1024) == 8192);
   CHECK(default_caustic_beam_paths_per_pass(4096 * 4096) == 20000);
   // Its photons: one per two pixels per pass, within [10000, 200000]; its light paths for light
-  // tracing's share: one per two pixels.
+  // tracing's share: one per four pixels (each also connects its medium rays to the sensor).
   CHECK(default_hybrid_photons_per_pass(256 * 192) == 24576);
   CHECK(default_hybrid_photons_per_pass(40 * 24) == 10000);
   CHECK(default_hybrid_photons_per_pass(1024 * 1024) == 200000);
-  CHECK(default_hybrid_light_paths_per_pass(256 * 192) == 24576);
+  CHECK(default_hybrid_light_paths_per_pass(256 * 192) == 12288);
   CHECK(default_hybrid_light_paths_per_pass(1) == 1);
   SceneDesc d = load_scene_string(R"({
     "camera": { "position": [0, 0, 100], "look_at": [0, 0, 0], "fov": 40, "resolution": [256, 192] },

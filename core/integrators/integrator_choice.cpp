@@ -98,10 +98,10 @@ int64_t default_hybrid_photons_per_pass(int64_t pixels) {
 }
 
 int64_t default_hybrid_light_paths_per_pass(int64_t pixels) {
-  // Where light tracing carries most of the error (fog under a glass sphere) half a path per
-  // pixel gave the same error per second as one, and where camera paths do (the floor caustic)
-  // 1.35x more; a quarter lost 0.78x in the fog (docs/PERFORMANCE.md).
-  return std::max<int64_t>(1, pixels / 2);
+  // A light path's sensor connections along its medium rays cost about as much as the rest of
+  // it: a quarter of a path per pixel then keeps the pass's time, with 1.26x the efficiency in
+  // the fog under a glass sphere and the same on the floor caustic (docs/PERFORMANCE.md).
+  return std::max<int64_t>(1, pixels / 4);
 }
 
 double pixel_footprint_mm(const CameraDesc& cam) {

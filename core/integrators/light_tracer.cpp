@@ -2,7 +2,10 @@
 
 #include <cmath>
 
+#include "core/constants.h"
+
 #include "media/phase_hg.h"
+#include "samplers/equiangular.h"
 
 namespace femto {
 
@@ -12,7 +15,8 @@ LightTracer::LightTracer(const Scene& scene, int max_depth, double t_cut_ps, Ver
       max_depth_(max_depth),
       t_cut_(t_cut_ps),
       unwarp_(scene.desc().time_mode == TimeMode::Unwarp),
-      vertices_(vertices) {}
+      vertices_(vertices),
+      sensor_rays_(scene.camera().perspective()) {}
 
 void LightTracer::splat(const Vec3& x, int m, const Vec3& w, double dist, const RGB& value,
                         double t_ps, double sigma_ps, double fx, double fy, std::vector<Splat>& out,
@@ -40,7 +44,47 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
   // The latest non-specular vertex, and whether a specular surface came after it.
   enum class Last { Other, Medium, Diffuse } last = Last::Other;
   bool specular_since = false;
-  walk_light_path(scene_, tracker_, rng, max_depth_, t_cut_, stats, [&](const LightVertex& v) {
+  // The current medium ray piece's equiangular sensor connection (sensor_rays_).
+  bool ray_active = false;
+  Ray ray_piece;
+  EquiangularSampler eq(Vec3(), Vec3(0, 0, 1), Vec3(), 0.0, 0.0);
+  const auto& media = scene_.media();
+  auto sigma_t_at = [](const Medium& med, const Vec3& x) {
+    return med.type == Medium::Type::Grid ? med.grid->sigma_t_at(x) : med.homogeneous.sigma_t();
+  };
+  auto visit = [&](const LightVertex& v) {
+    if (v.kind == LightVertex::Kind::Ray) {
+      // The ray pieces whose collisions are splatted, under mean-free-path sampling (its
+      // collision density sigma_t T is the other strategy of the MIS).
+      ray_active = false;
+      const Medium& med = media[static_cast<size_t>(v.medium)];
+      if ((indirect_only && !scattered) || med.strategy.kind != DistanceSampling::Mfp) return true;
+      // Up to the surface and the time cut-off (eta >= 1: time >= distance / c).
+      double s0 = 0.0, s1 = std::fmin(v.length, (t_cut_ - v.t_ps) * kSpeedOfLight);
+      if (!(s1 > 0) || !cam.frustum_interval(v.p, v.d, s0, s1)) return true;
+      eq = EquiangularSampler(v.p, v.d, cam.position(), s0, s1);
+      if (!eq.valid()) return true;
+      ray_active = true;
+      ray_piece = {v.p, v.d};
+      const double s = eq.sample(rng.uniform());
+      double tau, opl;
+      tracker_.segment_integrals(v.medium, ray_piece, s, tau, opl);
+      const double t_y = v.t_ps + opl / kSpeedOfLight;
+      if (!(t_y <= t_cut_)) return true;  // as the walk, which ends past t_cut
+      const Vec3 y = ray_piece.at(s);
+      const double sigma_t = sigma_t_at(med, y);
+      const double sigma_s = sigma_t * MediumTracker::albedo_at(med, y);
+      double fx, fy, dist, W;
+      Vec3 w;
+      if (!(sigma_s > 0) || !cam.connect_to(y, fx, fy, w, dist, W)) return true;
+      const double T = std::exp(-tau);
+      // Balance heuristic with the collisions: f / (p_eq + sigma_t T).
+      const double p_sum = eq.pdf(s) + sigma_t * T;
+      if (p_sum > 0)
+        splat(y, v.medium, w, dist, v.beta * (sigma_s * T * hg_eval(dot(v.d, w), v.g) * W / p_sum),
+              t_y, v.sigma_ps, fx, fy, out, stats);
+      return true;
+    }
     if (indirect_only) {
       if (v.kind == LightVertex::Kind::Surface) {
         const bool diffuse = v.bsdf->is_diffuse();
@@ -83,10 +127,22 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
       }
       case LightVertex::Kind::Segment:
         return true;
-      case LightVertex::Kind::Medium:
-        splat(v.p, v.medium, w, dist, v.beta * (hg_eval(dot(v.d, w), v.g) * W), v.t_ps, v.sigma_ps,
-              fx, fy, out, stats);
+      case LightVertex::Kind::Medium: {
+        double mis = 1.0;
+        if (ray_active && !v.connection_only) {
+          // The collision's half of the MIS with the ray piece's equiangular connection.
+          const double s = dot(v.p - ray_piece.o, ray_piece.d);
+          double tau, opl;
+          tracker_.segment_integrals(v.medium, ray_piece, s, tau, opl);
+          const double p_c = sigma_t_at(media[static_cast<size_t>(v.medium)], v.p) * std::exp(-tau);
+          mis = p_c / (p_c + eq.pdf(s));
+        }
+        splat(v.p, v.medium, w, dist, v.beta * (hg_eval(dot(v.d, w), v.g) * W * mis), v.t_ps,
+              v.sigma_ps, fx, fy, out, stats);
         return !v.connection_only;
+      }
+      case LightVertex::Kind::Ray:
+        return true;
       case LightVertex::Kind::Surface: {
         if (v.bsdf->is_delta()) return true;
         const Vec3 wi = v.frame->to_local(w);
@@ -104,7 +160,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
       }
     }
     return true;
-  });
+  };
+  walk_light_path(scene_, tracker_, rng, max_depth_, t_cut_, stats, visit, false, sensor_rays_);
 }
 
 }  // namespace femto

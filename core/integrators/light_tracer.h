@@ -46,6 +46,10 @@ class LightTracer {
   double t_cut_;
   bool unwarp_;
   Vertices vertices_;
+  /// Perspective camera: each medium ray piece the splatted vertices may lie on is also connected
+  /// to the sensor at a distance sampled equiangularly towards the pinhole, by MIS with the
+  /// collisions (the splat weighs 1 / dist^2, which collisions alone sample poorly).
+  bool sensor_rays_;
 };
 
 }  // namespace femto

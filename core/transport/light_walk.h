@@ -18,7 +18,7 @@ namespace femto {
 
 /// One vertex of a light sub-path, as handed to the visitor.
 struct LightVertex {
-  enum class Kind { Emitter, Surface, Medium, Segment };
+  enum class Kind { Emitter, Surface, Medium, Segment, Ray };
   Kind kind = Kind::Medium;
   Vec3 p;                           ///< position
   Vec3 d;                           ///< propagation direction of the path arriving at p
@@ -40,6 +40,9 @@ struct LightVertex {
   /// it escapes); beta and t_ps are at its start. Mean-free-path sampling makes the chance of the
   /// segment reaching s exactly the transmittance to s, so a beam needs no transmittance of its
   /// own.
+  /// Ray (light tracing's sensor connections): the straight piece of path in a scattering medium
+  /// that starts at p along d, up to the next surface (length; infinite if none), visited before
+  /// its distance is sampled.
   double length = 0;
   /// A medium vertex for connections only (the time-uniform collision of MIS distance sampling):
   /// the path does not continue from it.
@@ -58,9 +61,12 @@ inline int medium_at_origin(const Scene& scene, const Ray& ray) {
 /// whether the path goes on. Paths stop at t_cut_ps, at max_depth scattering vertices (counted),
 /// or when the visitor stops them. With `segments`, distances in media are sampled by mean free
 /// path whatever the medium's strategy, and every segment in a scattering medium is visited too.
+/// With `rays`, every straight piece in a scattering medium that may still hold a scattering
+/// vertex (depth below max_depth) is visited as a Ray before its distance is sampled.
 template <class Visitor>
 void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng, int max_depth,
-                     double t_cut_ps, PathStats& stats, Visitor&& visit, bool segments = false) {
+                     double t_cut_ps, PathStats& stats, Visitor&& visit, bool segments = false,
+                     bool rays = false) {
   const LightSet& lights = scene.lights();
   const auto& media = scene.media();
   const auto& shapes = scene.desc().shapes;
@@ -97,6 +103,20 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
         scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit);
     const double s_surf = found ? hit.s : std::numeric_limits<double>::infinity();
     const Medium& region = media[static_cast<size_t>(m)];
+    if (rays && depth < max_depth && region.interacts()) {
+      LightVertex r;
+      r.kind = LightVertex::Kind::Ray;
+      r.p = ray.o;
+      r.d = ray.d;
+      r.medium = m;
+      r.g = region.g();
+      r.beta = beta;
+      r.t_ps = t;
+      r.sigma_ps = v.sigma_ps;
+      r.chain = chain;
+      r.length = s_surf;
+      visit(static_cast<const LightVertex&>(r));
+    }
     Medium mfp_copy;
     if (segments) {
       mfp_copy = region;
