@@ -239,11 +239,11 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
             : opt.integrator == IntegratorKind::Beams
                 ? default_beam_paths_per_pass(static_cast<int64_t>(pixels))
                 : default_caustic_beam_paths_per_pass(static_cast<int64_t>(pixels))));
-  // The hybrid's light-traced share: about 4 splats per light path.
+  // The hybrid's light-traced share: at most about 8 splats per light path (light tracing's).
   if (opt.integrator == IntegratorKind::Hybrid)
     m.integrator +=
         static_cast<uint64_t>(default_hybrid_light_paths_per_pass(static_cast<int64_t>(pixels))) *
-            4 * (sizeof(Splat) + sizeof(const Splat*)) +
+            8 * (sizeof(Splat) + sizeof(const Splat*)) +
         (pixels + 1) * 8;
   if (opt.integrator == IntegratorKind::Light) m.integrator = light_batch_bytes(pixels);
   // Writing: a frame, the peak-time image, the contact sheet's 16 frames and its 8-bit image,

@@ -24,8 +24,9 @@ constexpr uint64_t kLightStream = 0x4000000000000000ULL;  // apart from camera p
 }  // namespace
 
 uint64_t light_batch_bytes(uint64_t pixels) {
-  // About 4 splats per light path (one per vertex that sees the camera) and their sort.
-  const uint64_t splats = static_cast<uint64_t>(kChunk * kChunksPerBatch) * 4;
+  // About 8 splats per light path (one per vertex and per medium ray piece that the camera sees:
+  // 7.7 in the default scene) and their sort.
+  const uint64_t splats = static_cast<uint64_t>(kChunk * kChunksPerBatch) * 8;
   return splats * (sizeof(Splat) + sizeof(const Splat*)) + (pixels + 1) * sizeof(uint32_t) * 2;
 }
 
