@@ -41,6 +41,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
   const double eps = scene_.ray_epsilon();
   const bool indirect_only = vertices_ == Vertices::MediumIndirect;
   bool scattered = false;  // a diffuse surface or medium vertex so far
+  bool surfaced = false;   // any surface vertex so far (caustic chains: light -> (S|G)+)
   // The latest non-specular vertex, and whether a specular surface came after it.
   enum class Last { Other, Medium, Diffuse } last = Last::Other;
   bool specular_since = false;
@@ -58,7 +59,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
       // collision density sigma_t T is the other strategy of the MIS).
       ray_active = false;
       const Medium& med = media[static_cast<size_t>(v.medium)];
-      if ((indirect_only && !scattered) || med.strategy.kind != DistanceSampling::Mfp) return true;
+      if ((indirect_only && !scattered && !surfaced) || med.strategy.kind != DistanceSampling::Mfp)
+        return true;
       // Up to the surface and the time cut-off (eta >= 1: time >= distance / c).
       double s0 = 0.0, s1 = std::fmin(v.length, (t_cut_ - v.t_ps) * kSpeedOfLight);
       if (!(s1 > 0) || !cam.frustum_interval(v.p, v.d, s0, s1)) return true;
@@ -87,6 +89,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
     }
     if (indirect_only) {
       if (v.kind == LightVertex::Kind::Surface) {
+        surfaced = true;
         const bool diffuse = v.bsdf->is_diffuse();
         scattered = scattered || diffuse;
         // Light scattered in a medium onto a diffuse surface, straight or through specular
@@ -103,14 +106,13 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
         if (!splat_here) return true;
       } else {
         if (v.kind != LightVertex::Kind::Medium) return true;
-        const bool after_scattering = scattered;
+        const bool after_scattering = scattered || surfaced;
         if (!v.connection_only) {
           scattered = true;
           last = Last::Medium;
           specular_since = false;
         }
-        // Direct light (light -> M) and caustics (light -> (S|G)+ -> M) are the camera paths'
-        // and the beams' share.
+        // Direct light (light -> M) is the camera paths' share.
         if (!after_scattering) return true;
       }
     }

@@ -23,8 +23,8 @@ struct Splat {
 class LightTracer {
  public:
   /// Which vertices are splatted. MediumIndirect: medium vertices whose light sub-path has
-  /// scattered before (off a diffuse surface or in a medium), light -> X* (D|M) X* -> M ->
-  /// sensor, and diffuse surface vertices reached straight from a medium scattering, light -> X*
+  /// scattered (off a diffuse surface or in a medium) or met a surface before, light -> X+ -> M
+  /// -> sensor, and diffuse surface vertices reached straight from a medium scattering, light -> X*
   /// M -> D -> sensor; the hybrid integrator's camera paths leave exactly those paths out
   /// (docs/ARCHITECTURE.md, "Path-space partition").
   enum class Vertices { All, MediumIndirect };

@@ -195,9 +195,10 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   };
   // All beams: they own the paths whose first non-specular vertex from the camera is in a medium.
   bool beam_prefix = beams != nullptr && !caustic_beams;
-  // Light tracing owns light -> X* (D|M) X* -> x_c -> camera, x_c the path's first vertex when it
-  // is a medium vertex: past x_c the path only looks for an emitter hit (the other half of x_c's
-  // next-event MIS) and ends at its next vertex.
+  // Light tracing owns light -> X+ -> x_c -> camera, x_c the path's first vertex when it is a
+  // medium vertex (any point of the camera's own segment, so no caustic beams there): past x_c the
+  // path only looks for an emitter hit (the other half of x_c's next-event MIS) and ends at its
+  // next vertex.
   bool past_xc = false;
   // It also owns light -> X* M S* -> x_c -> camera with x_c a diffuse surface: on the segments
   // leaving such an x_c through specular surfaces the path takes no light scattered in a medium
@@ -211,7 +212,8 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     const double s_surf = found ? hit.s : kInf;
     const Medium& med = media[static_cast<size_t>(m)];
     const bool medium_light = depth < max_depth_ && !past_xc && !from_xd;  // light tracing's else
-    if (caustic_beams && med.interacts() && medium_light)
+    // On the camera's own segment caustic light comes from light tracing (light_indirect).
+    if (caustic_beams && med.interacts() && medium_light && !(light_indirect && on_camera_segment))
       beams->gather(m, ray, s_surf, beta, t,
                     unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
     if (beam_prefix && med.interacts()) {

@@ -34,8 +34,9 @@ class VolPathIntegrator {
   /// With `beams`, light scattered in a medium before the path's first non-specular surface
   /// comes from photon beams gathered along those segments. With `light_indirect`, when the
   /// path's first vertex is a medium vertex x_c, only light arriving there directly (next-event
-  /// estimation, emission hit, caustic beams) comes from this path: light that scattered before
-  /// reaching x_c comes from light tracing (LightTracer::Vertices::MediumIndirect). When x_c is
+  /// estimation, emission hit) comes from this path: light that scattered or passed a surface
+  /// before reaching x_c comes from light tracing (LightTracer::Vertices::MediumIndirect), and
+  /// no caustic beams are gathered on the camera's own segment. When x_c is
   /// a diffuse surface, light reaching it straight from a medium scattering comes from light
   /// tracing too: on the segment leaving x_c this path takes no medium light.
   void trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats,
