@@ -322,6 +322,20 @@ TEST_CASE("path-only and hybrid agree on fog and ceiling light refracted onto th
   require_agreement(pt, hy, 8, 0.08);  // a 32% error would be 4 standard errors
 }
 
+namespace {
+
+/// 24 hybrid renders of 64 passes against 24 light-tracing renders of 60000 paths, cells that see
+/// the glass sphere (radius 12) at `sphere` left out.
+void hybrid_matches_light_tracing(const Scene& scene, const Vec3& sphere, uint64_t seed_light,
+                                  uint64_t seed_hybrid) {
+  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
+  const auto lt = cells(batches(scene, IntegratorKind::Light, 60000, 24, seed_light), 4, 2);
+  const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 64, 24, seed_hybrid, pd), 4, 2);
+  require_agreement(hy, lt, 12, 0.02, cells_seeing_sphere(scene, sphere, 12.5, 4, 2));
+}
+
+}  // namespace
+
 // Catches: wrong normalisation or timing of caustic beams and photons (camera paths cannot reach
 // light -> glass -> fog from a point light; light tracing splats every fog and floor vertex to
 // the camera, which sees them directly), and fog around the nested glass sphere handled
@@ -330,21 +344,7 @@ TEST_CASE("hybrid agrees with light tracing on a volumetric caustic from a point
           "[beams][statistical]") {
   const SceneDesc d =
       glass_in_fog(R"({ "type": "point", "position": [-30, 80, 0], "intensity": 3000 })", "");
-  const Scene scene(d);
-  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
-  std::vector<TransientFilm> lt;
-  for (int b = 0; b < 24; ++b) {
-    RenderOptions opt;
-    opt.integrator = IntegratorKind::Light;
-    opt.light_paths = 60000;
-    opt.seed = 1000 + static_cast<uint64_t>(b);
-    opt.threads = 2;
-    opt.quiet = true;
-    lt.push_back(render(scene, opt).film);
-  }
-  const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 64, 24, 1100, pd), 4, 2);
-  const std::vector<bool> skip = cells_seeing_sphere(scene, {-5, 35, 0}, 12.5, 4, 2);
-  require_agreement(hy, cells(lt, 4, 2), 12, 0.02, skip);
+  hybrid_matches_light_tracing(Scene(d), {-5, 35, 0}, 1000, 1100);
 }
 
 // Catches: the volumetric caustic seen directly counted twice or not at all in the hybrid (it
@@ -367,21 +367,7 @@ TEST_CASE("hybrid agrees with light tracing on a volumetric caustic seen directl
                   "cone_angle": 16, "falloff_start": 12 } ]
   })",
                                         "caustic in fog", ".");
-  const Scene scene(d);
-  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
-  std::vector<TransientFilm> lt;
-  for (int b = 0; b < 24; ++b) {
-    RenderOptions opt;
-    opt.integrator = IntegratorKind::Light;
-    opt.light_paths = 60000;
-    opt.seed = 1400 + static_cast<uint64_t>(b);
-    opt.threads = 2;
-    opt.quiet = true;
-    lt.push_back(render(scene, opt).film);
-  }
-  const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 64, 24, 1500, pd), 4, 2);
-  const std::vector<bool> skip = cells_seeing_sphere(scene, {-5, 45, 0}, 12.5, 4, 2);
-  require_agreement(hy, cells(lt, 4, 2), 12, 0.02, skip);
+  hybrid_matches_light_tracing(Scene(d), {-5, 45, 0}, 1400, 1500);
 }
 
 // Catches: the hybrid's light-traced splats (medium vertices after a scattering, traced in chunks

@@ -103,20 +103,23 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
         scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit);
     const double s_surf = found ? hit.s : std::numeric_limits<double>::infinity();
     const Medium& region = media[static_cast<size_t>(m)];
-    if (rays && depth < max_depth && region.interacts()) {
-      LightVertex r;
-      r.kind = LightVertex::Kind::Ray;
-      r.p = ray.o;
-      r.d = ray.d;
-      r.medium = m;
-      r.g = region.g();
-      r.beta = beta;
-      r.t_ps = t;
-      r.sigma_ps = v.sigma_ps;
-      r.chain = chain;
-      r.length = s_surf;
-      visit(static_cast<const LightVertex&>(r));
-    }
+    // A straight piece of the path from ray.o (a Ray or a beam Segment).
+    auto visit_piece = [&](LightVertex::Kind kind, double length) {
+      LightVertex piece;
+      piece.kind = kind;
+      piece.p = ray.o;
+      piece.d = ray.d;
+      piece.medium = m;
+      piece.g = region.g();
+      piece.beta = beta;
+      piece.t_ps = t;
+      piece.sigma_ps = v.sigma_ps;
+      piece.chain = chain;
+      piece.length = length;
+      visit(static_cast<const LightVertex&>(piece));
+    };
+    if (rays && depth < max_depth && region.interacts())
+      visit_piece(LightVertex::Kind::Ray, s_surf);
     Medium mfp_copy;
     if (segments) {
       mfp_copy = region;
@@ -125,20 +128,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
     const Medium& med = segments ? mfp_copy : region;
     const MediumSample ms = tracker.sample(med, ray, s_surf, rng);
     const bool scatters = med.type == Medium::Type::Grid || med.homogeneous.sigma_s > 0;
-    if (segments && scatters) {
-      LightVertex sg;
-      sg.kind = LightVertex::Kind::Segment;
-      sg.p = ray.o;
-      sg.d = ray.d;
-      sg.medium = m;
-      sg.g = med.g();
-      sg.beta = beta;
-      sg.t_ps = t;
-      sg.sigma_ps = v.sigma_ps;
-      sg.chain = chain;
-      sg.length = ms.main.s;
-      visit(static_cast<const LightVertex&>(sg));
-    }
+    if (segments && scatters) visit_piece(LightVertex::Kind::Segment, ms.main.s);
     if (ms.extra.collided && depth < max_depth) {
       const Vec3 x2 = ray.at(ms.extra.s);
       LightVertex c;
