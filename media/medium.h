@@ -20,6 +20,10 @@ struct Medium {
   double g() const { return homogeneous.g; }
   /// Whether light can scatter or be absorbed here (a clear region needs no distance sampling).
   bool interacts() const { return type == Type::Grid || homogeneous.sigma_t() > 0; }
+  /// Extinction coefficient at a point, 1/mm.
+  double sigma_t_at(const Vec3& p) const {
+    return type == Type::Grid ? grid->sigma_t_at(p) : homogeneous.sigma_t();
+  }
   /// Refractive index at a point.
   double eta_at(const Vec3& p) const { return type == Type::Grid ? grid->eta_at(p) : homogeneous.eta; }
 };

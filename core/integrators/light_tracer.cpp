@@ -50,9 +50,6 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
   Ray ray_piece;
   EquiangularSampler eq(Vec3(), Vec3(0, 0, 1), Vec3(), 0.0, 0.0);
   const auto& media = scene_.media();
-  auto sigma_t_at = [](const Medium& med, const Vec3& x) {
-    return med.type == Medium::Type::Grid ? med.grid->sigma_t_at(x) : med.homogeneous.sigma_t();
-  };
   auto visit = [&](const LightVertex& v) {
     if (v.kind == LightVertex::Kind::Ray) {
       // The ray pieces whose collisions are splatted, under mean-free-path sampling (its
@@ -74,7 +71,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
       const double t_y = v.t_ps + opl / kSpeedOfLight;
       if (!(t_y <= t_cut_)) return true;  // as the walk, which ends past t_cut
       const Vec3 y = ray_piece.at(s);
-      const double sigma_t = sigma_t_at(med, y);
+      const double sigma_t = med.sigma_t_at(y);
       const double sigma_s = sigma_t * MediumTracker::albedo_at(med, y);
       double fx, fy, dist, W;
       Vec3 w;
@@ -136,7 +133,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
           const double s = dot(v.p - ray_piece.o, ray_piece.d);
           double tau, opl;
           tracker_.segment_integrals(v.medium, ray_piece, s, tau, opl);
-          const double p_c = sigma_t_at(media[static_cast<size_t>(v.medium)], v.p) * std::exp(-tau);
+          const double p_c = media[static_cast<size_t>(v.medium)].sigma_t_at(v.p) * std::exp(-tau);
           mis = p_c / (p_c + eq.pdf(s));
         }
         splat(v.p, v.medium, w, dist, v.beta * (hg_eval(dot(v.d, w), v.g) * W * mis), v.t_ps,

@@ -70,8 +70,7 @@ VolPathIntegrator::DirectionMix VolPathIntegrator::direction_mix(const Medium& m
   if (tu) {
     mix.r_aux = e / (med.strategy.lambda * mix.eta);
   } else {
-    const double sigma_t =
-        med.type == Medium::Type::Grid ? med.grid->sigma_t_at(x) : med.homogeneous.sigma_t();
+    const double sigma_t = med.sigma_t_at(x);
     mix.r_aux = sigma_t > 0 ? e / sigma_t : std::numeric_limits<double>::infinity();
   }
   if (!std::isfinite(mix.r_aux)) return mix;
@@ -163,9 +162,7 @@ double VolPathIntegrator::collision_density(const Medium& med, int m, const Ray&
                                             double s) const {
   double tau, opl;
   tracker_.segment_integrals(m, ray, s, tau, opl);
-  const double sigma_t =
-      med.type == Medium::Type::Grid ? med.grid->sigma_t_at(ray.at(s)) : med.homogeneous.sigma_t();
-  return sigma_t * std::exp(-tau);
+  return med.sigma_t_at(ray.at(s)) * std::exp(-tau);
 }
 
 void VolPathIntegrator::estimate_segment(const Medium& med, int m, const ConnectedSegment& segment,
@@ -206,8 +203,7 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Connect
     double tau, opl;
     tracker_.segment_integrals(m, ray, s, tau, opl);
     const double T = std::exp(-tau);
-    const double sigma_t =
-        med.type == Medium::Type::Grid ? med.grid->sigma_t_at(y) : med.homogeneous.sigma_t();
+    const double sigma_t = med.sigma_t_at(y);
     // Multi-sample balance heuristic: f / (sum of the strategies' densities); the collisions'
     // density sigma_t T joins on time_mis segments.
     const double p_sum = (eq_ok ? eq.pdf(s) : 0.0) + (lp_ok ? target.lp.pdf(target.win, s) : 0.0) +
