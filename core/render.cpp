@@ -22,7 +22,7 @@
 namespace femto {
 
 namespace {
-constexpr int kTile = 16;
+using passes::kTile;
 
 /// The last sample's bandwidth at the median first-pass arrival inside the window (or at the
 /// window centre), for kernel_bandwidth.exr.

@@ -10,6 +10,9 @@
 
 namespace femto::passes {
 
+/// Square image tiles of kTile pixels: the unit of a pass's work and of the MPI ranks' bands.
+constexpr int kTile = 16;
+
 inline RGB load_rgb(const double* p) {
   return {p[0], p[1], p[2]};
 }

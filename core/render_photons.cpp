@@ -23,7 +23,7 @@
 namespace femto {
 
 namespace {
-constexpr int kTile = 16;
+using passes::kTile;
 constexpr int64_t kIndirectChunk = 1024;  // indirect-light paths per task (deterministic order)
 /// Indirect-light streams are keyed apart from camera pixels, photons and beams.
 constexpr uint64_t kIndirectStream = 0x7000000000000000ULL;

@@ -22,7 +22,6 @@ namespace femto::uniformity {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::string fmt(const char* f, double x) {
   char buf[64];

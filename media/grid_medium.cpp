@@ -8,13 +8,13 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/constants.h"
 #include "core/scene_desc.h"
 #include "media/volume_data.h"
 
 namespace femto {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 int floor_int(double x) {
   return clamped_floor(x);

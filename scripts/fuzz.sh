@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets of fuzz/ (clang, ASan, UBSan) in build-fuzz, replays their seeds
+# Builds the libFuzzer targets of fuzz/ (clang, ASan, UBSan) in build-asan, the build of
+# `scripts/quickstart.sh sanitize` (so after it nothing is compiled again), replays their seeds
 # and the fixed crash inputs of fuzz/regressions, then fuzzes each target for a fixed time.
 # Fails on any crash, hang (an input running longer than FEMTO_FUZZ_TIMEOUT seconds), memory
 # blow-up (RSS above 2.5 GB) or sanitizer report; the input that caused it is kept in
-# build-fuzz/fuzz/artifacts/TARGET/ (docs/RELIABILITY.md, "Fuzzing").
+# build-asan/fuzz/artifacts/TARGET/ (docs/RELIABILITY.md, "Fuzzing").
 #   scripts/fuzz.sh                 # 30 s per target
 #   scripts/fuzz.sh 3600            # an hour per target
 #   FEMTO_FUZZ_TARGETS=vdb scripts/fuzz.sh 600
-# Environment: FEMTO_FUZZ_BUILD_DIR (build-fuzz), FEMTO_FUZZ_TARGETS ("scene vdb flags"),
+# Environment: FEMTO_FUZZ_BUILD_DIR (build-asan), FEMTO_FUZZ_TARGETS ("scene vdb flags"),
 # FEMTO_FUZZ_TIMEOUT (10), FEMTO_JOBS (nproc), FEMTO_FUZZ_RUNS (stop each target after this many
 # inputs instead of the time budget).
 set -euo pipefail
@@ -17,15 +18,17 @@ case "$seconds" in
   ''|*[!0-9]*) echo "usage: $0 [SECONDS_PER_TARGET]" >&2; exit 2 ;;
 esac
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${FEMTO_FUZZ_BUILD_DIR:-$root/build-fuzz}"
+build="${FEMTO_FUZZ_BUILD_DIR:-$root/build-asan}"
 targets="${FEMTO_FUZZ_TARGETS:-scene vdb flags}"
 timeout="${FEMTO_FUZZ_TIMEOUT:-10}"
 jobs="${FEMTO_JOBS:-$(nproc 2>/dev/null || echo 2)}"
 
 "$root/scripts/quickstart.sh" deps  # cmake, the libraries, clang and its runtimes when missing
 
+# The configuration of `scripts/quickstart.sh sanitize` (keep the two the same).
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DFEMTO_FUZZ=ON -DFEMTO_BUILD_TESTS=OFF >/dev/null
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DFEMTO_SANITIZE=ON -DFEMTO_FUZZ=ON -DFEMTO_UNITY=ON \
+      -DFEMTO_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "$jobs" --target femto-fuzz
 
 # A corrupt .vdb may ask OpenVDB for any amount of memory. Allocations above 2 GiB fail (new

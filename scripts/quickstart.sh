@@ -2,7 +2,8 @@
 # femto quick start: installs what is missing (Debian 12), builds, then renders or tests.
 #   scripts/quickstart.sh demo      # Release build + render the default scene into ./femto-out
 #   scripts/quickstart.sh test      # Release build + run all tests (ctest)
-#   scripts/quickstart.sh sanitize  # clang build with ASan and UBSan (build-asan) + all tests
+#   scripts/quickstart.sh sanitize  # clang build with ASan and UBSan (build-asan) + all tests;
+#                                   # the same build holds the fuzz targets (scripts/fuzz.sh)
 #   scripts/quickstart.sh deps      # only install what is missing (also clang for the two above)
 set -euo pipefail
 
@@ -40,10 +41,12 @@ fi
 
 if [ "$mode" = sanitize ]; then
   # -O1: the instrumented suite runs a few times slower than Release; -O1 compiles faster than
-  # -O2 and keeps reports readable. Assertions stay on (no NDEBUG).
+  # -O2 and keeps reports readable. Assertions stay on (no NDEBUG). FEMTO_FUZZ: the fuzz targets
+  # are libFuzzer programs of this same build, so scripts/fuzz.sh compiles nothing more.
   build="${FEMTO_BUILD_DIR:-$root/build-asan}"
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-        -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DFEMTO_SANITIZE=ON
+        -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DFEMTO_SANITIZE=ON -DFEMTO_FUZZ=ON -DFEMTO_UNITY=ON \
+        -DFEMTO_BUILD_BENCH=OFF
   cmake --build "$build" -j "$jobs"
   cd "$build"
   ctest --output-on-failure -j "$jobs"  # ASAN_OPTIONS and UBSAN_OPTIONS: set per test by CMake
@@ -51,7 +54,7 @@ if [ "$mode" = sanitize ]; then
 fi
 
 build="${FEMTO_BUILD_DIR:-$root/build}"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DFEMTO_UNITY=ON
 cmake --build "$build" -j "$jobs"
 
 if [ "$mode" = demo ]; then

@@ -22,27 +22,27 @@ using Json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
 
 // A folder private to this process (test cases may run as parallel processes), removed at exit.
-struct TempDir {
+struct LoaderTempDir {
   fs::path path;
-  TempDir() {
+  LoaderTempDir() {
     std::random_device rd;
     const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
     path = fs::temp_directory_path() /
            ("femto-scene-loader-" + std::to_string(rd()) + "-" + std::to_string(stamp));
     fs::create_directories(path);
   }
-  ~TempDir() {
+  ~LoaderTempDir() {
     std::error_code ec;
     fs::remove_all(path, ec);
   }
 };
 
 inline const fs::path& temp_dir() {
-  static TempDir dir;
+  static LoaderTempDir dir;
   return dir.path;
 }
 
-inline std::string write_file(const std::string& name, const std::string& text) {
+inline std::string write_temp_file(const std::string& name, const std::string& text) {
   const fs::path p = temp_dir() / name;
   std::ofstream(p, std::ios::binary) << text;
   return p.string();
@@ -67,7 +67,7 @@ inline const char* const kTetObj =
     "f 2 3 4\n";
 
 inline Json base_scene() {
-  write_file("tet.obj", kTetObj);
+  write_temp_file("tet.obj", kTetObj);
   return Json::parse(R"({
     "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "up": [0, 2, 0], "fov": 30,
                "resolution": [32, 24]},

@@ -32,7 +32,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-json small_scene() {
+json bad_cli_scene() {
   return json::parse(R"({
     "camera": {"position": [0, 0, 100], "look_at": [0, 0, 0], "resolution": [16, 8]},
     "time": {"bin_width": 50, "bins": 8},
@@ -57,7 +57,9 @@ void check_refused(const femto::test::Run& r, const fs::path& out) {
   CHECK_FALSE(fs::exists(out));
 }
 
-json render_json(const fs::path& out) { return json::parse(femto::test::read_file(out / "render.json")); }
+json bad_cli_render_json(const fs::path& out) {
+  return json::parse(femto::test::read_file(out / "render.json"));
+}
 
 }  // namespace
 
@@ -81,7 +83,7 @@ TEST_CASE("cli: an endless scene file exits 2", "[robust]") {
 // Was: exit 0 with inf in transient.npy.
 TEST_CASE("cli: emission 1e308 exits 2 and writes nothing", "[robust]") {
   TempDir tmp("femto_bad_cli");
-  json j = small_scene();
+  json j = bad_cli_scene();
   j["shapes"][0]["emission"] = 1e308;
   write_file(tmp.dir / "scene.json", j.dump());
   check_refused(run_femto({"render", "scene.json", "--out", "out"}, tmp.dir), tmp.dir / "out");
@@ -90,7 +92,7 @@ TEST_CASE("cli: emission 1e308 exits 2 and writes nothing", "[robust]") {
 // Was: --max-memory 1e30 became 0 B (an out-of-range double to integer cast).
 TEST_CASE("cli: --max-memory beyond 2^64 bytes means no limit", "[robust]") {
   TempDir tmp("femto_bad_cli");
-  write_file(tmp.dir / "scene.json", small_scene().dump());
+  write_file(tmp.dir / "scene.json", bad_cli_scene().dump());
   const auto ok = run_femto({"render", "scene.json", "--max-memory", "1e30", "--out", "a", "--quiet",
                              "--frames", "none", "--no-previews"},
                             tmp.dir);
@@ -134,7 +136,7 @@ TEST_CASE("cli: the widest allowed pulse in the cloud scene renders cleanly", "[
                            tmp.dir);
   INFO(r.err);
   REQUIRE(r.code == 0);
-  CHECK(render_json(tmp.dir / "out").at("counters").at("nonfinite_film_values_zeroed") == 0);
+  CHECK(bad_cli_render_json(tmp.dir / "out").at("counters").at("nonfinite_film_values_zeroed") == 0);
   std::string far = femto::test::read_file(tmp.dir / "scene.json");
   far.replace(far.find("1e9"), 3, "1e12");  // beyond the bound: refused by the loader
   write_file(tmp.dir / "far.json", far);
@@ -145,13 +147,13 @@ TEST_CASE("cli: the widest allowed pulse in the cloud scene renders cleanly", "[
 // --max-depth 1 (single scattering) reported as a warning.
 TEST_CASE("cli: render.json and stderr describe what actually happened", "[robust]") {
   TempDir tmp("femto_bad_cli");
-  write_file(tmp.dir / "scene.json", small_scene().dump());
+  write_file(tmp.dir / "scene.json", bad_cli_scene().dump());
   const auto r = run_femto({"render", "scene.json", "--threads", "4096", "--max-depth", "1",
                             "--frames", "none", "--no-previews", "--out", "out"},
                            tmp.dir);
   INFO(r.err);
   REQUIRE(r.code == 0);
-  const json info = render_json(tmp.dir / "out");
+  const json info = bad_cli_render_json(tmp.dir / "out");
   const int hw = static_cast<int>(std::thread::hardware_concurrency());
   CHECK(info.at("settings").at("threads_requested") == 4096);
   CHECK(info.at("settings").at("threads").get<int>() <= std::max(hw, 1));

@@ -21,7 +21,7 @@ using Json = nlohmann::ordered_json;
 
 namespace {
 
-Json base_scene() {
+Json bad_input_scene() {
   return Json::parse(R"({
     "camera": {"position": [0, 0, 100], "look_at": [0, 0, 0], "resolution": [8, 8]},
     "time": {"bin_width": 10, "bins": 10},
@@ -34,7 +34,7 @@ Json base_scene() {
 }
 
 // The loader's message for `text`, checked to be one bounded line naming the file.
-std::string error_of_text(const std::string& text) {
+std::string bad_scene_error(const std::string& text) {
   try {
     femto::load_scene_string(text, "bad.json", ".");
   } catch (const InputError& e) {
@@ -49,9 +49,9 @@ std::string error_of_text(const std::string& text) {
 }
 
 std::string error_with(const std::function<void(Json&)>& edit) {
-  Json j = base_scene();
+  Json j = bad_input_scene();
   edit(j);
-  return error_of_text(j.dump());
+  return bad_scene_error(j.dump());
 }
 
 }  // namespace
@@ -59,10 +59,10 @@ std::string error_with(const std::function<void(Json&)>& edit) {
 // Was: stack overflow (SIGSEGV) printing a 100,000-deep value in the error message.
 TEST_CASE("deeply nested JSON is refused at depth 64 without recursion", "[robust]") {
   const std::string deep = std::string(100000, '[') + std::string(100000, ']');
-  CHECK_THAT(error_of_text(deep), Contains("nested more than 64 levels"));
+  CHECK_THAT(bad_scene_error(deep), Contains("nested more than 64 levels"));
   const std::string deep_in_key = R"({"camera": )" + std::string(100000, '[') + "1" +
                                   std::string(100000, ']') + "}";
-  CHECK_THAT(error_of_text(deep_in_key), Contains("/camera") && Contains("nested"));
+  CHECK_THAT(bad_scene_error(deep_in_key), Contains("/camera") && Contains("nested"));
 }
 
 // Was: Embree assertion abort on coordinates beyond float range; the loader took any double.

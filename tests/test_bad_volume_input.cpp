@@ -36,7 +36,7 @@ std::string sparse_volume(const fs::path& dir, const std::vector<int>& xs, doubl
 }
 
 // The InputError message of loading `file`, or "" when it loads.
-std::string load_error(const std::string& file, uint64_t max_bytes = 16ull << 30) {
+std::string bad_volume_error(const std::string& file, uint64_t max_bytes = 16ull << 30) {
   VdbMediumDesc d;
   d.file = file;
   d.max_dense_bytes = max_bytes;
@@ -86,7 +86,7 @@ TEST_CASE("a metadata value whose stated size differs from its type's is refused
              Contains("of type int32 claims 12 bytes; the type has 4"));
   CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x42b, "int32")),
              Contains("of type int32 claims 8 bytes; the type has 4"));
-  CHECK_THAT(load_error(patched(tmp.dir, 0xba, "int32")),
+  CHECK_THAT(bad_volume_error(patched(tmp.dir, 0xba, "int32")),
              Contains("patched.vdb: corrupt or unsupported OpenVDB file: grid 1 metadata entry 2"));
   // OpenVDB reads its "__delayedload" metadata (0x149: size 699, leaf count 180 at 0x15a, then a
   // 35-byte blosc chunk) by the sizes inside it, not by the stated size.
@@ -141,8 +141,10 @@ TEST_CASE("value chunks must have the size of their node", "[robust]") {
   const auto int32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
   CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd, int64(-4096))),
              Contains("holds 4096 uncompressed bytes where the node has 180"));
-  CHECK_THAT(load_error(patched(tmp.dir, 0x56bd, int64(-4096))),
-             Contains("patched.vdb: corrupt or unsupported OpenVDB file: grid 1 value chunk at offset 22205"));
+  CHECK_THAT(
+      bad_volume_error(patched(tmp.dir, 0x56bd, int64(-4096))),
+      Contains(
+          "patched.vdb: corrupt or unsupported OpenVDB file: grid 1 value chunk at offset 22205"));
   CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd, int64(INT64_MIN))),
              Contains("holds 9223372036854775808 uncompressed bytes"));
   CHECK_THAT(vdb_structure_problem(patched(tmp.dir, 0x56bd, int64(int64_t(1) << 40))), Contains("remain"));
@@ -165,12 +167,12 @@ TEST_CASE("files without grid offsets are refused", "[robust]") {
 // Was: SIGSEGV: the box size x_max - x_min + 1 overflowed int to 0 cells, densify wrote via null.
 TEST_CASE("voxels at INT_MIN and INT_MAX are refused by 64-bit box arithmetic", "[robust]") {
   test::TempDir tmp("femto_bad_vdb");
-  const std::string msg = load_error(sparse_volume(tmp.dir, {INT_MIN, INT_MAX}));
+  const std::string msg = bad_volume_error(sparse_volume(tmp.dir, {INT_MIN, INT_MAX}));
   CHECK_THAT(msg, Contains("sparse.vdb") && Contains("4294967296 x 1 x 1") && Contains("2^30 cells"));
   // A single voxel at INT_MAX is a 1-cell box: it loads (the fill loop must not overflow) when
   // its world position is inside the bounds, and is refused cleanly when not.
-  CHECK(load_error(sparse_volume(tmp.dir, {INT_MAX}, 1e-3)) == "");
-  CHECK_THAT(load_error(sparse_volume(tmp.dir, {INT_MAX})), Contains("beyond +-1e9 mm"));
+  CHECK(bad_volume_error(sparse_volume(tmp.dir, {INT_MAX}, 1e-3)) == "");
+  CHECK_THAT(bad_volume_error(sparse_volume(tmp.dir, {INT_MAX})), Contains("beyond +-1e9 mm"));
 }
 
 // Was: an 8 GB allocation for a 19 KB file (a box just under the old 2^31-cell limit).
@@ -178,17 +180,17 @@ TEST_CASE("far-apart voxels are refused before the dense box is allocated", "[ro
   test::TempDir tmp("femto_bad_vdb");
   const std::string file = sparse_volume(tmp.dir, {-1000000000, 1000000000});
   CHECK(fs::file_size(file) < 100000);
-  CHECK_THAT(load_error(file), Contains("2000000001 x 1 x 1") && Contains("2^30 cells"));
+  CHECK_THAT(bad_volume_error(file), Contains("2000000001 x 1 x 1") && Contains("2^30 cells"));
   // A box within the cell limit but above the memory --max-memory leaves for volumes.
   const std::string mid = sparse_volume(tmp.dir, {0, 99999999});
-  CHECK_THAT(load_error(mid, 64ull << 20), Contains("left by --max-memory"));
+  CHECK_THAT(bad_volume_error(mid, 64ull << 20), Contains("left by --max-memory"));
 }
 
 // Was: std::bad_alloc from OpenVDB's reader, exit 1 without naming the file. Since the
 // structure check walks the tree's chunks, the bad size is found before OpenVDB reads it.
 TEST_CASE("a corrupt size inside the grid data is bad input naming the file", "[robust]") {
   test::TempDir tmp("femto_bad_vdb");
-  CHECK_THAT(load_error(damaged(tmp.dir, 3530, 0x04)),
+  CHECK_THAT(bad_volume_error(damaged(tmp.dir, 3530, 0x04)),
              Contains("/media/m/file: ") && Contains("damaged.vdb") && Contains("corrupt or unsupported OpenVDB file"));
 }
 
@@ -201,7 +203,7 @@ TEST_CASE("corrupt headers, metadata sizes and truncation are caught by the stru
   CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x9a, 0x40)), Contains("metadata entry"));
   CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 0x6f, 0x10)), Contains("offsets"));
   CHECK_THAT(vdb_structure_problem(damaged(tmp.dir, 100, 0)), Contains("remain"));
-  CHECK_THAT(load_error(damaged(tmp.dir, 0x9a, 0x40)), Contains("damaged.vdb: corrupt or unsupported"));
+  CHECK_THAT(bad_volume_error(damaged(tmp.dir, 0x9a, 0x40)), Contains("damaged.vdb: corrupt or unsupported"));
 }
 
 // Every single-bit flip in the header, descriptors and metadata either loads or is an
@@ -211,7 +213,7 @@ TEST_CASE("bit flips across the structure of an example volume never crash", "[r
   int refused = 0;
   for (size_t at = 0; at < 0x160; ++at) {
     INFO("byte " << at);
-    const std::string msg = load_error(damaged(tmp.dir, at, 0x08));
+    const std::string msg = bad_volume_error(damaged(tmp.dir, at, 0x08));
     if (!msg.empty()) {
       CHECK_THAT(msg, Contains("damaged.vdb"));
       ++refused;

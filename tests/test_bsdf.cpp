@@ -33,7 +33,7 @@ namespace st = femto::stats;
 namespace {
 
 constexpr int kChi2Tests = 28;  // 2 diffuse + 10 rough conductor + 16 rough dielectric
-constexpr double kAlpha = 1e-3 / kChi2Tests;
+constexpr double kChiSquareAlpha = 1e-3 / kChi2Tests;
 constexpr double kSigmas = 5.0;  // two-sided normal tail 6e-7 per check
 
 // ---- materials
@@ -52,7 +52,7 @@ Bsdf make(MaterialDesc::Type type, double eta_or_alpha = 0.0, double alpha = 0.0
   }
   return Bsdf::from_material(m, 1.0);
 }
-Bsdf diffuse(RGB albedo) {
+Bsdf diffuse_bsdf(RGB albedo) {
   return make(MaterialDesc::Type::Diffuse, 0, 0, albedo);
 }
 Bsdf conductor(double alpha, RGB f0 = RGB(1.0)) {
@@ -61,7 +61,7 @@ Bsdf conductor(double alpha, RGB f0 = RGB(1.0)) {
 Bsdf rough_glass(double eta, double alpha) {
   return make(MaterialDesc::Type::RoughDielectric, eta, alpha);
 }
-Bsdf glass(double eta) {
+Bsdf glass_bsdf(double eta) {
   return make(MaterialDesc::Type::Dielectric, eta);
 }
 
@@ -189,12 +189,12 @@ st::Chi2Result chi2_bsdf(const Bsdf& b, const Vec3& wo, uint64_t seed) {
   return r;
 }
 
-#define CHECK_CHI2(r)                                                                  \
-  do {                                                                                 \
-    const st::Chi2Result r_ = (r);                                                     \
-    INFO("chi2 = " << r_.chi2 << "  dof = " << r_.dof << "  p = " << r_.p_value        \
-                   << "  pooled = " << r_.cells_pooled << "  threshold = " << kAlpha); \
-    CHECK(r_.p_value >= kAlpha);                                                       \
+#define CHECK_CHI2(r)                                                                           \
+  do {                                                                                          \
+    const st::Chi2Result r_ = (r);                                                              \
+    INFO("chi2 = " << r_.chi2 << "  dof = " << r_.dof << "  p = " << r_.p_value                 \
+                   << "  pooled = " << r_.cells_pooled << "  threshold = " << kChiSquareAlpha); \
+    CHECK(r_.p_value >= kChiSquareAlpha);                                                       \
   } while (false)
 
 // ---- Monte Carlo integrals over the sphere
@@ -249,7 +249,7 @@ Furnace furnace(const Bsdf& b, const Vec3& wo, TransportMode mode, uint64_t seed
 
 // Catches a material mapped to the wrong family, or flags the integrator relies on being wrong.
 TEST_CASE("Bsdf::from_material families and flags", "[bsdf]") {
-  const Bsdf d = diffuse(RGB(0.5)), m = make(MaterialDesc::Type::Mirror), g = glass(1.5),
+  const Bsdf d = diffuse_bsdf(RGB(0.5)), m = make(MaterialDesc::Type::Mirror), g = glass_bsdf(1.5),
              rg = rough_glass(1.5, 0.2), rc = conductor(0.2);
   CHECK((d.is_diffuse() && !d.is_delta() && !d.transmits()));
   CHECK((!m.is_diffuse() && m.is_delta() && !m.transmits()));
@@ -305,7 +305,7 @@ TEST_CASE("GGX D and visible-normal densities are normalised", "[bsdf][ggx]") {
 
 // Catches cosine sampling on the wrong side for wo below the surface, or a pdf without 1/pi.
 TEST_CASE("Diffuse sampling matches its pdf", "[bsdf][chi2]") {
-  const Bsdf b = diffuse(RGB(0.7));
+  const Bsdf b = diffuse_bsdf(RGB(0.7));
   uint64_t seed = 100;
   for (const double theta : {30.0, 130.0}) {
     INFO("theta = " << theta);
@@ -371,7 +371,7 @@ TEST_CASE("BSDF chi2 has power", "[bsdf][chi2]") {
 
 // Catches sample() weights or pdfs that disagree with f() and pdf(), or f > 0 where pdf() = 0.
 TEST_CASE("BSDF sample weight and pdf equal f |cos| / pdf and pdf()", "[bsdf]") {
-  const std::vector<Bsdf> bsdfs = {diffuse(RGB(0.2, 0.5, 0.9)),
+  const std::vector<Bsdf> bsdfs = {diffuse_bsdf(RGB(0.2, 0.5, 0.9)),
                                    conductor(0.05, RGB(0.9, 0.6, 0.3)),
                                    conductor(0.3),
                                    conductor(0.8),
@@ -421,7 +421,7 @@ TEST_CASE("BSDF sample weight and pdf equal f |cos| / pdf and pdf()", "[bsdf]") 
 // Catches a Lambertian f without 1/pi, or f non-zero on the far side.
 TEST_CASE("Diffuse white furnace integral equals the albedo", "[bsdf][energy]") {
   for (const double albedo : {0.2, 0.9}) {
-    const Bsdf b = diffuse(RGB(albedo));
+    const Bsdf b = diffuse_bsdf(RGB(albedo));
     for (const double theta : {0.0, 60.0, 140.0}) {
       const Estimate e = furnace(b, incidence(theta), TransportMode::Radiance, 11).all;
       INFO("albedo " << albedo << " theta " << theta << ": " << e.mean << " +- " << e.se);
@@ -470,7 +470,7 @@ TEST_CASE("Rough dielectric conserves energy and tends to Fresnel", "[bsdf][ener
 // Catches a wrong Fresnel formula (normal, Brewster and critical angles) or R + T != 1.
 TEST_CASE("Smooth dielectric Fresnel and lobe probabilities", "[bsdf][energy]") {
   const double eta = 1.5;
-  const Bsdf b = glass(eta);
+  const Bsdf b = glass_bsdf(eta);
   BsdfSample r, t;
   const auto lobes = [&](const Vec3& wo) {
     REQUIRE(b.sample(wo, 0.0, 0.5, 0.5, TransportMode::Radiance, r));
@@ -509,7 +509,7 @@ TEST_CASE("Smooth dielectric Fresnel and lobe probabilities", "[bsdf][energy]") 
 // Catches the 1/eta^2 radiance factor in the wrong mode or inverted, or refraction off Snell.
 TEST_CASE("Smooth dielectric sample weights in both modes", "[bsdf]") {
   const double eta = 1.5;
-  const Bsdf b = glass(eta);
+  const Bsdf b = glass_bsdf(eta);
   for (const double theta : {25.0, 155.0}) {
     const Vec3 wo = incidence(theta);
     const bool outside = wo.z > 0.0;
@@ -583,7 +583,8 @@ TEST_CASE("BSDF generalised reciprocity", "[bsdf]") {
       CHECK(nonzero_t > 2000);
       CHECK(nonzero_r > 1000);
     }
-  for (const Bsdf& b : {diffuse(RGB(0.6)), conductor(0.05, RGB(0.9, 0.6, 0.3)), conductor(0.5)}) {
+  for (const Bsdf& b :
+       {diffuse_bsdf(RGB(0.6)), conductor(0.05, RGB(0.9, 0.6, 0.3)), conductor(0.5)}) {
     double worst = 0.0;
     for (int n = 0; n < 20000; ++n) {
       const Vec3 wo = femto::sample_uniform_sphere(rng.uniform(), rng.uniform());
@@ -610,9 +611,9 @@ TEST_CASE("BSDFs stay finite at degenerate inputs", "[bsdf]") {
     for (const double sign : {1.0, -1.0})
       dirs.push_back({std::sqrt(1.0 - z * z) * 0.6, std::sqrt(1.0 - z * z) * 0.8, sign * z});
   const double us[] = {0.0, 1e-300, 0.5, std::nextafter(1.0, 0.0)};
-  const std::vector<Bsdf> bsdfs = {diffuse(RGB(0.5)),
+  const std::vector<Bsdf> bsdfs = {diffuse_bsdf(RGB(0.5)),
                                    make(MaterialDesc::Type::Mirror),
-                                   glass(1.5),
+                                   glass_bsdf(1.5),
                                    conductor(1e-4),
                                    conductor(1.0),
                                    rough_glass(1.5, 1e-4),

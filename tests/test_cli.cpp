@@ -39,12 +39,12 @@ struct CliTempDir : femto::test::TempDir {
   CliTempDir() : femto::test::TempDir("femto_test_cli") {}
 };
 
-std::string read_text(const fs::path& p) {
+std::string read_cli_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-void write_text(const fs::path& p, const std::string& text) {
+void write_cli_text(const fs::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary);
   out << text;
   REQUIRE(out.good());
@@ -69,7 +69,7 @@ struct RunResult {
 
 // Runs femto with `args` from folder `cwd` (so a stray default ./femto-out would land in the
 // temp folder too); stdout and stderr are captured in files under `logs`, which is created.
-RunResult run_femto(const std::vector<std::string>& args, const fs::path& cwd, const fs::path& logs) {
+RunResult run_cli(const std::vector<std::string>& args, const fs::path& cwd, const fs::path& logs) {
   fs::create_directories(logs);
   RunResult r;
   std::string cmd = shell_quote(FEMTO_BINARY);
@@ -81,12 +81,14 @@ RunResult run_femto(const std::vector<std::string>& args, const fs::path& cwd, c
                            " </dev/null";
   const int status = std::system(full.c_str());
   if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
-  r.out = read_text(out);
-  r.err = read_text(err);
+  r.out = read_cli_file(out);
+  r.err = read_cli_file(err);
   return r;
 }
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool cli_contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
 
 std::vector<char> read_bytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -95,7 +97,7 @@ std::vector<char> read_bytes(const fs::path& p) {
 
 // A small valid scene: a camera, a time axis, a foggy global medium, one diffuse quad and one
 // point light. 40 x 24 pixels is several 16-pixel tiles, so --threads 2 really splits the work.
-json small_scene() {
+json cli_scene() {
   return json::parse(R"({
     "camera": { "type": "perspective", "position": [0, 0, 100], "look_at": [0, 0, 0],
                 "fov": 40, "resolution": [40, 24] },
@@ -112,7 +114,7 @@ json small_scene() {
 }
 
 // Sorted names of the entries directly inside `dir`.
-std::set<std::string> listing(const fs::path& dir) {
+std::set<std::string> cli_listing(const fs::path& dir) {
   std::set<std::string> names;
   for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
   return names;
@@ -132,7 +134,7 @@ size_t count_lines(const std::string& s) {
 TEST_CASE("cli: default scene at 1 spp writes consistent outputs", "[cli]") {
   CliTempDir tmp;
   const fs::path out = tmp.dir / "out";
-  const RunResult r = run_femto({"render", "--spp", "1", "--frames", "files", "--out", out.string(), "--quiet"},
+  const RunResult r = run_cli({"render", "--spp", "1", "--frames", "files", "--out", out.string(), "--quiet"},
                                 tmp.dir, tmp.dir / "logs");
   INFO(r.command << "\nstderr: " << r.err);
   REQUIRE(r.code == 0);
@@ -146,7 +148,7 @@ TEST_CASE("cli: default scene at 1 spp writes consistent outputs", "[cli]") {
   CHECK_FALSE(fs::exists(out / "transient.exr"));
 
   // The expected dimensions come from the scene the binary embeds.
-  const json scene = json::parse(read_text(fs::path(FEMTO_SOURCE_DIR) / "data/scenes/default.json"));
+  const json scene = json::parse(read_cli_file(fs::path(FEMTO_SOURCE_DIR) / "data/scenes/default.json"));
   const int W = scene["camera"]["resolution"][0].get<int>();
   const int H = scene["camera"]["resolution"][1].get<int>();
   const int T = scene["time"]["bins"].get<int>();
@@ -162,7 +164,7 @@ TEST_CASE("cli: default scene at 1 spp writes consistent outputs", "[cli]") {
   CHECK(exr_frames == static_cast<size_t>(T));
   CHECK(entries == static_cast<size_t>(T));
 
-  const json info = json::parse(read_text(out / "render.json"));
+  const json info = json::parse(read_cli_file(out / "render.json"));
   const std::vector<size_t> expected_shape = {size_t(H), size_t(W), size_t(T), 3};
   CHECK(info.at("film").at("npy_shape").get<std::vector<size_t>>() == expected_shape);
   CHECK(info.at("film").at("width").get<int>() == W);
@@ -238,14 +240,14 @@ TEST_CASE("cli: default scene at 1 spp writes consistent outputs", "[cli]") {
 // none / --no-previews still writing frames or PNGs.
 TEST_CASE("cli: --frames multipart and --frames none", "[cli]") {
   CliTempDir tmp;
-  const json scene = small_scene();
+  const json scene = cli_scene();
   const int T = scene["time"]["bins"].get<int>();
-  write_text(tmp.dir / "scene.json", scene.dump(2));
+  write_cli_text(tmp.dir / "scene.json", scene.dump(2));
 
   SECTION("multipart") {
     // Catches: a multi-part transient.exr with a wrong part count, or a frames/ folder beside it.
     const fs::path out = tmp.dir / "out";
-    const RunResult r = run_femto({"render", "scene.json", "--spp", "1", "--frames", "multipart",
+    const RunResult r = run_cli({"render", "scene.json", "--spp", "1", "--frames", "multipart",
                                    "--out", out.string(), "--quiet"},
                                   tmp.dir, tmp.dir / "logs");
     INFO(r.command << "\nstderr: " << r.err);
@@ -261,7 +263,7 @@ TEST_CASE("cli: --frames multipart and --frames none", "[cli]") {
   SECTION("none, no previews") {
     // Catches: --frames none or --no-previews being ignored.
     const fs::path out = tmp.dir / "out";
-    const RunResult r = run_femto({"render", "scene.json", "--spp", "1", "--frames=none",
+    const RunResult r = run_cli({"render", "scene.json", "--spp", "1", "--frames=none",
                                    "--no-previews", "--out", out.string(), "--quiet"},
                                   tmp.dir, tmp.dir / "logs");
     INFO(r.command << "\nstderr: " << r.err);
@@ -280,41 +282,44 @@ TEST_CASE("cli: --frames multipart and --frames none", "[cli]") {
 // // comments, which the scene loader accepts.
 TEST_CASE("cli: render.json stays valid JSON for scene files with comments", "[cli]") {
   CliTempDir tmp;
-  std::string text = small_scene().dump(2);
+  std::string text = cli_scene().dump(2);
   text.insert(text.find('{') + 1, "\n  // a comment the loader skips\n");
-  write_text(tmp.dir / "commented.json", text);
+  write_cli_text(tmp.dir / "commented.json", text);
   const fs::path out = tmp.dir / "out";
-  const RunResult r = run_femto({"render", "commented.json", "--spp", "1", "--frames", "none", "--no-previews",
+  const RunResult r = run_cli({"render", "commented.json", "--spp", "1", "--frames", "none", "--no-previews",
                                  "--out", out.string(), "--quiet"},
                                 tmp.dir, tmp.dir / "logs");
   INFO(r.command << "\nstderr: " << r.err);
   REQUIRE(r.code == 0);
-  const json info = json::parse(read_text(out / "render.json"), nullptr, false);
+  const json info = json::parse(read_cli_file(out / "render.json"), nullptr, false);
   REQUIRE_FALSE(info.is_discarded());
-  CHECK(info["scene"]["json"]["time"]["bins"] == small_scene()["time"]["bins"]);
+  CHECK(info["scene"]["json"]["time"]["bins"] == cli_scene()["time"]["bins"]);
 }
 
 // Catches: the kernel film's scene keys or flags being ignored, render.json not recording them,
 // kernel_bandwidth.exr missing or holding nonsense, and the kernel film losing energy against the
 // histogram film rendered from the same paths.
-TEST_CASE("cli: --reconstruction kernel records its settings and keeps the histogram's energy", "[cli]") {
+TEST_CASE("cli: --reconstruction kernel records its settings and keeps the histogram's energy",
+          "[cli]") {
   CliTempDir tmp;
-  json scene = small_scene();
+  json scene = cli_scene();
   scene["time"]["reconstruction"] = {{"type", "kernel"}, {"kernel", "perlin"}, {"k", 12}};
-  write_text(tmp.dir / "scene.json", scene.dump(2));
+  write_cli_text(tmp.dir / "scene.json", scene.dump(2));
   const fs::path kout = tmp.dir / "kernel", hout = tmp.dir / "histogram";
-  const RunResult k = run_femto({"render", "scene.json", "--spp", "6", "--kernel", "epanechnikov", "--alpha",
-                                 "0.7", "--frames", "none", "--no-previews", "--out", kout.string(), "--quiet"},
-                                tmp.dir, tmp.dir / "logs_k");
+  const RunResult k =
+      run_cli({"render", "scene.json", "--spp", "6", "--kernel", "epanechnikov", "--alpha", "0.7",
+               "--frames", "none", "--no-previews", "--out", kout.string(), "--quiet"},
+              tmp.dir, tmp.dir / "logs_k");
   INFO(k.command << "\nstderr: " << k.err);
   REQUIRE(k.code == 0);
-  const RunResult h = run_femto({"render", "scene.json", "--spp", "6", "--reconstruction", "histogram", "--frames",
-                                 "none", "--no-previews", "--out", hout.string(), "--quiet"},
-                                tmp.dir, tmp.dir / "logs_h");
+  const RunResult h =
+      run_cli({"render", "scene.json", "--spp", "6", "--reconstruction", "histogram", "--frames",
+               "none", "--no-previews", "--out", hout.string(), "--quiet"},
+              tmp.dir, tmp.dir / "logs_h");
   INFO(h.command << "\nstderr: " << h.err);
   REQUIRE(h.code == 0);
 
-  const json kj = json::parse(read_text(kout / "render.json"));
+  const json kj = json::parse(read_cli_file(kout / "render.json"));
   const json& rec = kj["settings"]["reconstruction"];
   CHECK(rec["type"] == "kernel");
   CHECK(rec["kernel"] == "epanechnikov");  // the flag overrides the scene
@@ -322,7 +327,7 @@ TEST_CASE("cli: --reconstruction kernel records its settings and keeps the histo
   CHECK(rec["k"].get<int>() == 12);        // the scene's key survives
   CHECK(rec["first_pass_spp"].get<int>() == 160);
   CHECK(rec["onset_reflection"].get<bool>());
-  CHECK(json::parse(read_text(hout / "render.json"))["settings"]["reconstruction"]["type"] == "histogram");
+  CHECK(json::parse(read_cli_file(hout / "render.json"))["settings"]["reconstruction"]["type"] == "histogram");
   CHECK_FALSE(fs::exists(hout / "kernel_bandwidth.exr"));
 
   int w = 0, hgt = 0;
@@ -367,7 +372,7 @@ TEST_CASE("cli: --version and --help", "[cli]") {
   CliTempDir tmp;
   SECTION("--version") {
     // Catches: a version string that differs from the project version, or a non-zero exit.
-    const RunResult r = run_femto({"--version"}, tmp.dir, tmp.dir / "logs");
+    const RunResult r = run_cli({"--version"}, tmp.dir, tmp.dir / "logs");
     INFO(r.out << r.err);
     CHECK(r.code == 0);
     CHECK(r.out.rfind(std::string("femto ") + FEMTO_VERSION, 0) == 0);
@@ -377,21 +382,21 @@ TEST_CASE("cli: --version and --help", "[cli]") {
   }
   SECTION("--help") {
     // Catches: top-level help exiting non-zero or not mentioning the render command.
-    const RunResult r = run_femto({"--help"}, tmp.dir, tmp.dir / "logs");
+    const RunResult r = run_cli({"--help"}, tmp.dir, tmp.dir / "logs");
     CHECK(r.code == 0);
-    CHECK(contains(r.out, "render"));
-    CHECK(contains(r.out, "--version"));
+    CHECK(cli_contains(r.out, "render"));
+    CHECK(cli_contains(r.out, "--version"));
     CHECK(r.err.empty());
   }
   SECTION("render --help lists every parsed option") {
     // Catches: an option added to cmd_render.cpp without documenting it in its --help.
-    const std::string src = read_text(fs::path(FEMTO_SOURCE_DIR) / "apps/cmd_render.cpp");
+    const std::string src = read_cli_file(fs::path(FEMTO_SOURCE_DIR) / "apps/cmd_render.cpp");
     const std::regex opt_re(R"re(a == "(--[A-Za-z0-9-]+)")re");
     std::set<std::string> options;
     for (auto it = std::sregex_iterator(src.begin(), src.end(), opt_re); it != std::sregex_iterator(); ++it)
       options.insert((*it)[1].str());
     REQUIRE(options.size() >= 8);  // guards against the regex silently matching nothing
-    const RunResult r = run_femto({"render", "--help"}, tmp.dir, tmp.dir / "logs");
+    const RunResult r = run_cli({"render", "--help"}, tmp.dir, tmp.dir / "logs");
     CHECK(r.code == 0);
     CHECK(r.err.empty());
     for (const auto& o : options) {
@@ -412,9 +417,9 @@ TEST_CASE("cli: bad input exits 2 with a one-line message and writes nothing", "
   const std::string out = (tmp.dir / "out").string();
 
   auto scene_with = [&](const std::string& name, const std::function<void(json&)>& edit) {
-    json s = small_scene();
+    json s = cli_scene();
     edit(s);
-    write_text(work / name, s.dump(2));
+    write_cli_text(work / name, s.dump(2));
     return name;
   };
   const std::string good = scene_with("good.json", [](json&) {});
@@ -464,11 +469,11 @@ TEST_CASE("cli: bad input exits 2 with a one-line message and writes nothing", "
   };
   {
     // JSON syntax error: the comma before "lights" removed.
-    std::string text = small_scene().dump(2);
+    std::string text = cli_scene().dump(2);
     const size_t k = text.find("\"lights\"");
     REQUIRE(k != std::string::npos);
     text.erase(text.rfind(',', k), 1);
-    write_text(work / "syntax.json", text);
+    write_cli_text(work / "syntax.json", text);
   }
   bad_scene("a JSON syntax error reported without file and position", "syntax.json",
             {"syntax.json", "line"});
@@ -500,29 +505,30 @@ TEST_CASE("cli: bad input exits 2 with a one-line message and writes nothing", "
   bad_scene("a misspelt reconstruction accepted",
             scene_with("recon.json", [](json& s) { s["time"]["reconstruction"] = "kernal"; }),
             {"/time/reconstruction", "kernal"});
-  bad_scene("a missing mesh file reported late or vaguely",
-            scene_with("mesh.json",
-                       [](json& s) {
-                         s["shapes"].push_back({{"type", "mesh"},
-                                                {"file", "missing_mesh.obj"},
-                                                {"material", {{"type", "diffuse"}, {"albedo", 0.5}}}});
-                       }),
-            {"/shapes/1/file", "missing_mesh.obj"});
+  bad_scene(
+      "a missing mesh file reported late or vaguely",
+      scene_with("mesh.json",
+                 [](json& s) {
+                   s["shapes"].push_back({{"type", "mesh"},
+                                          {"file", "missing_mesh.obj"},
+                                          {"material", {{"type", "diffuse"}, {"albedo", 0.5}}}});
+                 }),
+      {"/shapes/1/file", "missing_mesh.obj"});
 
-  const std::set<std::string> before = listing(work);
+  const std::set<std::string> before = cli_listing(work);
   int index = 0;
   for (const auto& c : cases) {
     // Each case: bug it would catch is c.what.
-    const RunResult r = run_femto(c.args, work, tmp.dir / ("logs" + std::to_string(index++)));
+    const RunResult r = run_cli(c.args, work, tmp.dir / ("logs" + std::to_string(index++)));
     INFO("case: " << c.what << "\ncommand: " << r.command << "\nstderr: " << r.err);
     CHECK(r.code == 2);
     CHECK(count_lines(r.err) == 1);
     for (const auto& e : c.expect) {
       INFO("message should contain '" << e << "'");
-      CHECK(contains(r.err, e));
+      CHECK(cli_contains(r.err, e));
     }
     CHECK_FALSE(fs::exists(out));
-    CHECK(listing(work) == before);  // no femto-out or other stray file either
+    CHECK(cli_listing(work) == before);  // no femto-out or other stray file either
     std::error_code ec;
     fs::remove_all(out, ec);  // so one failure does not cascade into the next cases
   }
@@ -532,15 +538,15 @@ TEST_CASE("cli: bad input exits 2 with a one-line message and writes nothing", "
 // --seed that is ignored.
 TEST_CASE("cli: same seed gives identical bytes for any thread count", "[cli]") {
   CliTempDir tmp;
-  write_text(tmp.dir / "scene.json", small_scene().dump(2));
+  write_cli_text(tmp.dir / "scene.json", cli_scene().dump(2));
   auto render = [&](const std::string& name, const std::string& seed, const std::string& threads) {
     const fs::path out = tmp.dir / name;
-    const RunResult r = run_femto({"render", "scene.json", "--seed", seed, "--threads", threads,
+    const RunResult r = run_cli({"render", "scene.json", "--seed", seed, "--threads", threads,
                                    "--frames", "none", "--no-previews", "--out", out.string(), "--quiet"},
                                   tmp.dir, tmp.dir / ("logs_" + name));
     INFO(r.command << "\nstderr: " << r.err);
     REQUIRE(r.code == 0);
-    const json info = json::parse(read_text(out / "render.json"));
+    const json info = json::parse(read_cli_file(out / "render.json"));
     CHECK(info.at("settings").at("seed").get<uint64_t>() == std::stoull(seed));
     CHECK(info.at("settings").at("threads_requested").get<int>() == std::stoi(threads));
     return read_bytes(out / "transient.npy");
@@ -558,14 +564,14 @@ TEST_CASE("cli: same seed gives identical bytes for any thread count", "[cli]") 
 // Catches: an unknown subcommand (or none at all) treated as success.
 TEST_CASE("cli: unknown subcommand exits 2", "[cli]") {
   CliTempDir tmp;
-  const RunResult r = run_femto({"rendr", "--out", (tmp.dir / "out").string()}, tmp.dir, tmp.dir / "logs");
+  const RunResult r = run_cli({"rendr", "--out", (tmp.dir / "out").string()}, tmp.dir, tmp.dir / "logs");
   INFO(r.err);
   CHECK(r.code == 2);
-  CHECK(contains(r.err, "rendr"));
+  CHECK(cli_contains(r.err, "rendr"));
   CHECK(count_lines(r.err) == 1);
   CHECK_FALSE(fs::exists(tmp.dir / "out"));
   // Catches: bare `femto` exiting 0, so scripts would not notice a missing command.
-  const RunResult none = run_femto({}, tmp.dir, tmp.dir / "logs_none");
+  const RunResult none = run_cli({}, tmp.dir, tmp.dir / "logs_none");
   CHECK(none.code == 2);
 }
 
@@ -574,10 +580,10 @@ TEST_CASE("cli: unknown subcommand exits 2", "[cli]") {
 // or photon settings lost.
 TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
   CliTempDir tmp;
-  json s = small_scene();
+  json s = cli_scene();
   s["shapes"].push_back(json::parse(R"({ "type": "sphere", "center": [0, 0, 20], "radius": 10,
                                           "material": { "type": "dielectric", "eta": 1.5 } })"));
-  write_text(tmp.dir / "glass.json", s.dump(2));
+  write_cli_text(tmp.dir / "glass.json", s.dump(2));
   struct Case {
     std::vector<std::string> flags;
     std::string type, why_part;
@@ -586,22 +592,27 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
       {{}, "hybrid", "auto"},
       {{"--integrator", "path"}, "path", "chosen"},
       {{"--integrator", "light", "--light-paths", "2e4"}, "light", "chosen"},  // counts as 1e5 too
-      {{"--integrator", "photons", "--photons", "3000", "--photon-radius", "2", "--photon-bandwidth", "20"},
-       "photons", "chosen"},
+      {{"--integrator", "photons", "--photons", "3000", "--photon-radius", "2",
+        "--photon-bandwidth", "20"},
+       "photons",
+       "chosen"},
       {{"--integrator", "beams", "--photons", "5e2"}, "beams", "chosen"},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
     const fs::path out = tmp.dir / ("out" + std::to_string(i));
-    std::vector<std::string> args = {"render", (tmp.dir / "glass.json").string(), "--spp", "2", "--out", out.string(),
-                                     "--quiet", "--frames", "none", "--no-previews"};
+    std::vector<std::string> args = {"render",  (tmp.dir / "glass.json").string(),
+                                     "--spp",   "2",
+                                     "--out",   out.string(),
+                                     "--quiet", "--frames",
+                                     "none",    "--no-previews"};
     args.insert(args.end(), cases[i].flags.begin(), cases[i].flags.end());
-    const RunResult r = run_femto(args, tmp.dir, tmp.dir / ("logs" + std::to_string(i)));
+    const RunResult r = run_cli(args, tmp.dir, tmp.dir / ("logs" + std::to_string(i)));
     INFO(r.command << "\nstderr: " << r.err);
     REQUIRE(r.code == 0);
-    const json info = json::parse(read_text(out / "render.json"));
+    const json info = json::parse(read_cli_file(out / "render.json"));
     const json& integ = info["settings"]["integrator"];
     CHECK(integ["type"] == cases[i].type);
-    CHECK(contains(integ["why"].get<std::string>(), cases[i].why_part));
+    CHECK(cli_contains(integ["why"].get<std::string>(), cases[i].why_part));
     if (cases[i].type == "photons" || cases[i].type == "hybrid") {
       CHECK(integ["passes"] == 2);
       // The hybrid's default is one photon per two pixels, at least 10000 (40 x 24 pixels here).
@@ -648,18 +659,18 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
 // diffuse surface: glass in fog), a share of each pass for nothing.
 TEST_CASE("cli: the hybrid traces no photons without a diffuse surface", "[cli]") {
   CliTempDir tmp;
-  json s = small_scene();
+  json s = cli_scene();
   s["shapes"] = json::parse(R"([ { "type": "sphere", "center": [0, 0, 20], "radius": 10,
                                    "material": { "type": "dielectric", "eta": 1.5 } } ])");
-  write_text(tmp.dir / "glass.json", s.dump(2));
+  write_cli_text(tmp.dir / "glass.json", s.dump(2));
   const fs::path out = tmp.dir / "out";
-  const RunResult r = run_femto({"render", (tmp.dir / "glass.json").string(), "--spp", "2",
+  const RunResult r = run_cli({"render", (tmp.dir / "glass.json").string(), "--spp", "2",
                                  "--integrator", "hybrid", "--photons", "500", "--out",
                                  out.string(), "--quiet", "--frames", "none", "--no-previews"},
                                 tmp.dir, tmp.dir / "logs");
   INFO(r.command << "\nstderr: " << r.err);
   REQUIRE(r.code == 0);
-  const json info = json::parse(read_text(out / "render.json"));
+  const json info = json::parse(read_cli_file(out / "render.json"));
   CHECK(info["timing"]["pass_seconds"]["photons"].get<double>() == 0.0);
   CHECK(info["timing"]["pass_seconds"]["beams"].get<double>() > 0.0);
   // Per pass: 500 beam light paths and one indirect light path per four pixels (40 x 24), no
@@ -673,12 +684,12 @@ TEST_CASE("cli: the hybrid traces no photons without a diffuse surface", "[cli]"
 // message and nothing written.
 TEST_CASE("cli: bad integrator input exits 2 naming the key and value", "[cli]") {
   CliTempDir tmp;
-  const json s = small_scene();
-  write_text(tmp.dir / "good.json", s.dump(2));
+  const json s = cli_scene();
+  write_cli_text(tmp.dir / "good.json", s.dump(2));
   auto with = [&](const std::string& name, const std::function<void(json&)>& edit) {
-    json t = small_scene();
+    json t = cli_scene();
     edit(t);
-    write_text(tmp.dir / name, t.dump(2));
+    write_cli_text(tmp.dir / name, t.dump(2));
     return (tmp.dir / name).string();
   };
   const std::string good = (tmp.dir / "good.json").string();
@@ -691,34 +702,56 @@ TEST_CASE("cli: bad integrator input exits 2 naming the key and value", "[cli]")
       {{"render", good, "--integrator", "bidir"}, {"--integrator", "bidir"}},
       {{"render", good, "--integrator", "photons", "--photons", "-5"}, {"--photons", "-5"}},
       {{"render", good, "--integrator", "photons", "--photons", "0"}, {"--photons", "0"}},
-      {{"render", good, "--integrator", "photons", "--photon-radius", "0"}, {"--photon-radius", "0"}},
-      {{"render", good, "--integrator", "photons", "--photon-bandwidth", "-1"}, {"--photon-bandwidth", "-1"}},
-      {{"render", good, "--integrator", "path", "--photons", "1000"}, {"--photons", "photon mapping and photon beams only"}},
+      {{"render", good, "--integrator", "photons", "--photon-radius", "0"},
+       {"--photon-radius", "0"}},
+      {{"render", good, "--integrator", "photons", "--photon-bandwidth", "-1"},
+       {"--photon-bandwidth", "-1"}},
+      {{"render", good, "--integrator", "path", "--photons", "1000"},
+       {"--photons", "photon mapping and photon beams only"}},
       {{"render", good, "--light-paths", "1000", "--integrator", "path"}, {"--light-paths"}},
-      {{"render", good, "--integrator", "light", "--reconstruction", "kernel"}, {"light", "kernel film"}},
-      {{"render", with("nofog.json", [](json& t) { t.erase("media"); t.erase("medium"); }), "--integrator",
-        "beams"},
+      {{"render", good, "--integrator", "light", "--reconstruction", "kernel"},
+       {"light", "kernel film"}},
+      {{"render",
+        with("nofog.json",
+             [](json& t) {
+               t.erase("media");
+               t.erase("medium");
+             }),
+        "--integrator", "beams"},
        {"beams", "no scattering medium"}},
       {{"render", with("k1.json", [](json& t) { t["render"]["integrator"] = "photon"; })},
        {"/render/integrator", "photon"}},
-      {{"render", with("k2.json", [](json& t) { t["render"]["photons"] = json{{"per_pass", -1}}; })},
+      {{"render", with("k2.json",
+                       [](json& t) {
+                         t["render"]["photons"] = json{{"per_pass", -1}};
+                       })},
        {"/render/photons/per_pass", "-1"}},
-      {{"render", with("k3.json", [](json& t) { t["render"]["photons"] = json{{"radius", 0}}; })},
+      {{"render", with("k3.json",
+                       [](json& t) {
+                         t["render"]["photons"] = json{{"radius", 0}};
+                       })},
        {"/render/photons/radius", "0"}},
-      {{"render", with("k4.json", [](json& t) { t["render"]["photons"] = json{{"alpha", 1.5}}; })},
+      {{"render", with("k4.json",
+                       [](json& t) {
+                         t["render"]["photons"] = json{{"alpha", 1.5}};
+                       })},
        {"/render/photons/alpha", "1.5"}},
-      {{"render", with("k5.json", [](json& t) { t["render"]["photons"] = json{{"radius_mm", 1}}; })},
+      {{"render", with("k5.json",
+                       [](json& t) {
+                         t["render"]["photons"] = json{{"radius_mm", 1}};
+                       })},
        {"/render/photons", "radius_mm"}},
-      {{"render", with("k6.json", [](json& t) { t["render"]["light_paths"] = 0; })}, {"/render/light_paths", "0"}},
+      {{"render", with("k6.json", [](json& t) { t["render"]["light_paths"] = 0; })},
+       {"/render/light_paths", "0"}},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
     std::vector<std::string> args = cases[i].args;
     args.insert(args.end(), {"--out", out, "--quiet"});
-    const RunResult r = run_femto(args, tmp.dir, tmp.dir / ("logs" + std::to_string(i)));
+    const RunResult r = run_cli(args, tmp.dir, tmp.dir / ("logs" + std::to_string(i)));
     INFO(r.command << "\nstderr: " << r.err);
     CHECK(r.code == 2);
     CHECK(count_lines(r.err) == 1);
-    for (const auto& part : cases[i].expect) CHECK(contains(r.err, part));
+    for (const auto& part : cases[i].expect) CHECK(cli_contains(r.err, part));
     CHECK_FALSE(fs::exists(out));
   }
 }

@@ -46,7 +46,7 @@ DiffusionSetup make_setup(double sigma_s, double sigma_a, double g, double eta, 
   return s;
 }
 
-std::string read_text(const fs::path& p) {
+std::string read_diffusion_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
@@ -449,31 +449,31 @@ TEST_CASE("plot module draws axes, coloured series and a legend", "[diffusion][p
 
 namespace {
 
-struct Run {
+struct DiffusionRun {
   int code = -1;
   std::string err;
 };
 
-Run run_femto(const std::vector<std::string>& args, const fs::path& cwd) {
+DiffusionRun run_diffusion(const std::vector<std::string>& args, const fs::path& cwd) {
   std::string cmd = "cd '" + cwd.string() + "' && '" FEMTO_BINARY "'";
   for (const auto& a : args) cmd += " '" + a + "'";
   cmd += " >/dev/null 2>stderr.txt </dev/null";
   const int status = std::system(cmd.c_str());
-  Run r;
+  DiffusionRun r;
   if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
-  r.err = read_text(cwd / "stderr.txt");
+  r.err = read_diffusion_file(cwd / "stderr.txt");
   return r;
 }
 
-struct TempDir : test::TempDir {
-  TempDir() : test::TempDir("femto_test_diffusion") {}
+struct DiffusionDir : test::TempDir {
+  DiffusionDir() : test::TempDir("femto_test_diffusion") {}
 };
 
 }  // namespace
 
 // Catches bad flags accepted, messages not naming flag and value, or output written too early.
 TEST_CASE("femto diffusion rejects bad flags with exit 2 and writes nothing", "[diffusion][cli]") {
-  TempDir tmp;
+  DiffusionDir tmp;
   struct Bad {
     std::vector<std::string> flags;
     std::string named;  // the flag the message must name
@@ -495,7 +495,7 @@ TEST_CASE("femto diffusion rejects bad flags with exit 2 and writes nothing", "[
   for (const Bad& b : bad) {
     std::vector<std::string> args = {"diffusion", "--out", "out", "--quiet"};
     args.insert(args.end(), b.flags.begin(), b.flags.end());
-    const Run r = run_femto(args, tmp.dir);
+    const DiffusionRun r = run_diffusion(args, tmp.dir);
     INFO(b.flags.front() << " -> " << r.err);
     REQUIRE(r.code == 2);
     REQUIRE(r.err.find("femto diffusion: " + b.named + ": ") != std::string::npos);
@@ -508,7 +508,7 @@ TEST_CASE("femto diffusion rejects bad flags with exit 2 and writes nothing", "[
 // Catches missing outputs, CSV columns drifting from the documentation, thread-dependent files.
 TEST_CASE("femto diffusion writes the documented outputs, identical for any thread count",
           "[diffusion][cli]") {
-  TempDir tmp;
+  DiffusionDir tmp;
   const std::vector<std::string> base = {
       "diffusion", "--photons", "6000",   "--t-end", "20",      "--t-bins",     "40",
       "--r-bins",  "40",        "--seed", "3",       "--quiet", "--plot-times", "2,8,16"};
@@ -517,16 +517,16 @@ TEST_CASE("femto diffusion writes the documented outputs, identical for any thre
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
   };
-  const Run r1 = run_femto(with({"--threads", "1", "--out", "one"}), tmp.dir);
+  const DiffusionRun r1 = run_diffusion(with({"--threads", "1", "--out", "one"}), tmp.dir);
   INFO(r1.err);
   REQUIRE(r1.code == 0);
-  const Run r2 = run_femto(with({"--threads", "2", "--out", "two"}), tmp.dir);
+  const DiffusionRun r2 = run_diffusion(with({"--threads", "2", "--out", "two"}), tmp.dir);
   REQUIRE(r2.code == 0);
   for (const char* f : {"fluence.csv", "moments.csv", "models.csv", "fluence_models.csv",
                         "summary.json", "fluence.png", "distance.png"})
     REQUIRE(fs::exists(tmp.dir / "one" / f));
-  const std::string fl = read_text(tmp.dir / "one" / "fluence.csv"),
-                    mo = read_text(tmp.dir / "one" / "moments.csv");
+  const std::string fl = read_diffusion_file(tmp.dir / "one" / "fluence.csv"),
+                    mo = read_diffusion_file(tmp.dir / "one" / "moments.csv");
   REQUIRE(first_line(fl) ==
           "t_ps,r_mm,energy_density,energy_density_stderr,fluence_rate,fluence_rate_stderr");
   REQUIRE(first_line(mo) ==
@@ -534,9 +534,9 @@ TEST_CASE("femto diffusion writes the documented outputs, identical for any thre
           "distance");
   REQUIRE(std::count(fl.begin(), fl.end(), '\n') == 1 + 40 * 40);
   REQUIRE(std::count(mo.begin(), mo.end(), '\n') == 1 + 40);
-  REQUIRE(fl == read_text(tmp.dir / "two" / "fluence.csv"));
-  REQUIRE(mo == read_text(tmp.dir / "two" / "moments.csv"));
-  const auto js = nlohmann::json::parse(read_text(tmp.dir / "one" / "summary.json"));
+  REQUIRE(fl == read_diffusion_file(tmp.dir / "two" / "fluence.csv"));
+  REQUIRE(mo == read_diffusion_file(tmp.dir / "two" / "moments.csv"));
+  const auto js = nlohmann::json::parse(read_diffusion_file(tmp.dir / "one" / "summary.json"));
   REQUIRE(js["inputs"]["medium"]["sigma_s_per_mm"] == 4.1);
   REQUIRE(js["transition"]["threshold"] == 0.05);
   REQUIRE(js["transition"]["by_threshold"].size() == 3);

@@ -26,8 +26,8 @@ using namespace femto;
 namespace {
 
 // A fresh directory per test case, removed afterwards, with path and leftover helpers.
-struct TempDir : test::TempDir {
-  TempDir() : test::TempDir("femto_test_io") {}
+struct IoDir : test::TempDir {
+  IoDir() : test::TempDir("femto_test_io") {}
   std::string operator/(const std::string& name) const { return (dir / name).string(); }
   // Names of the leftover temporaries (".tmp.") in the directory.
   std::vector<std::string> temporaries() const {
@@ -39,7 +39,7 @@ struct TempDir : test::TempDir {
   }
 };
 
-std::string slurp(const std::string& path) {
+std::string slurp_io_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
@@ -71,7 +71,7 @@ std::vector<float> ramp(size_t n, float scale) {
 }  // namespace
 
 TEST_CASE("NPY float32 round trip and header layout", "[io][npy]") {
-  TempDir tmp;
+  IoDir tmp;
   const std::string path = tmp / "a.npy";
   const std::vector<size_t> shape{2, 3, 4};
   std::vector<float> data = ramp(24, 0.25f);
@@ -79,7 +79,7 @@ TEST_CASE("NPY float32 round trip and header layout", "[io][npy]") {
   data[7] = -3.4e38f;
   write_npy_float32(path, shape, data.data());
 
-  const std::string bytes = slurp(path);
+  const std::string bytes = slurp_io_file(path);
   REQUIRE(bytes.compare(0, 6, "\x93NUMPY") == 0);
   REQUIRE(bytes[6] == 1);
   REQUIRE(bytes[7] == 0);
@@ -100,7 +100,7 @@ TEST_CASE("NPY float32 round trip and header layout", "[io][npy]") {
   SECTION("1-d and 0-d shapes") {
     const float v[3] = {1, 2, 3};
     write_npy_float32(path, {3}, v);
-    REQUIRE(slurp(path).find("'shape': (3,)") != std::string::npos);
+    REQUIRE(slurp_io_file(path).find("'shape': (3,)") != std::string::npos);
     read_npy_float32(path, shape2, data2);
     REQUIRE(shape2 == std::vector<size_t>{3});
     REQUIRE(data2 == std::vector<float>{1, 2, 3});
@@ -113,7 +113,7 @@ TEST_CASE("NPY float32 round trip and header layout", "[io][npy]") {
     const std::vector<size_t> many(30000, 1);  // more dims than numpy allows, but valid NPY 2.0
     const float one = 42;
     write_npy_float32(path, many, &one);
-    const std::string b = slurp(path);
+    const std::string b = slurp_io_file(path);
     REQUIRE(b[6] == 2);
     const size_t len = be32(std::string{b[11], b[10], b[9], b[8]}, 0);  // little-endian uint32
     REQUIRE((12 + len) % 64 == 0);
@@ -124,14 +124,14 @@ TEST_CASE("NPY float32 round trip and header layout", "[io][npy]") {
 }
 
 TEST_CASE("NPY reader rejects foreign files", "[io][npy]") {
-  TempDir tmp;
+  IoDir tmp;
   std::vector<size_t> shape;
   std::vector<float> data;
   const float v[2] = {1, 2};
   // Rewrites one header field of a valid file, keeping the header length.
   auto patched = [&](const std::string& from, const std::string& to) {
     write_npy_float32(tmp / "x.npy", {2}, v);
-    std::string b = slurp(tmp / "x.npy");
+    std::string b = slurp_io_file(tmp / "x.npy");
     b.replace(b.find(from), from.size(), to);
     std::ofstream(tmp / "bad.npy", std::ios::binary) << b;
     return tmp / "bad.npy";
@@ -148,7 +148,7 @@ TEST_CASE("NPY files load in numpy", "[io][npy][python]") {
     WARN("numpy not importable by /usr/bin/python3; skipping");
     return;
   }
-  TempDir tmp;
+  IoDir tmp;
   const std::string path = tmp / "n.npy", out = tmp / "n.txt";
   const std::vector<float> data = ramp(2 * 3 * 5, 0.5f);
   write_npy_float32(path, {2, 3, 5}, data.data());
@@ -157,11 +157,11 @@ TEST_CASE("NPY files load in numpy", "[io][npy][python]") {
                           path + "' > '" + out + "'";
   REQUIRE(std::system(cmd.c_str()) == 0);
   const std::string expected = "(2, 3, 5) float32 True " + std::to_string(data.back()).substr(0, 4);
-  REQUIRE(slurp(out).substr(0, expected.size()) == expected);
+  REQUIRE(slurp_io_file(out).substr(0, expected.size()) == expected);
 }
 
 TEST_CASE("EXR RGB round trip is exact and keeps attributes", "[io][exr]") {
-  TempDir tmp;
+  IoDir tmp;
   const std::string path = tmp / "img.exr";
   const int w = 5, h = 3;
   std::vector<float> rgb = ramp(size_t(w) * h * 3, 0.1f);
@@ -184,7 +184,7 @@ TEST_CASE("EXR RGB round trip is exact and keeps attributes", "[io][exr]") {
 }
 
 TEST_CASE("EXR arbitrary channels", "[io][exr]") {
-  TempDir tmp;
+  IoDir tmp;
   const std::string path = tmp / "peak_time.exr";
   const int w = 4, h = 2;
   const std::vector<float> y = ramp(8, 12.5f), a = ramp(8, -1.0f);
@@ -202,7 +202,7 @@ TEST_CASE("EXR arbitrary channels", "[io][exr]") {
 }
 
 TEST_CASE("multi-part EXR holds one part per time bin", "[io][exr]") {
-  TempDir tmp;
+  IoDir tmp;
   const std::string path = tmp / "frames.exr";
   const int w = 3, h = 2, t_bins = 4;
   const std::vector<float> hwtc = ramp(size_t(w) * h * t_bins * 3, 0.125f);
@@ -233,13 +233,13 @@ TEST_CASE("multi-part EXR holds one part per time bin", "[io][exr]") {
 }
 
 TEST_CASE("PNG has the signature and IHDR size", "[io][png]") {
-  TempDir tmp;
+  IoDir tmp;
   const std::string path = tmp / "img.png";
   const int w = 7, h = 5;
   std::vector<uint8_t> rgb(size_t(w) * h * 3);
   for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = static_cast<uint8_t>(i * 7);
   write_png_rgb8(path, w, h, rgb.data());
-  const std::string b = slurp(path);
+  const std::string b = slurp_io_file(path);
   REQUIRE(b.size() > 33);
   REQUIRE(b.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0);
   REQUIRE(be32(b, 8) == 13);  // IHDR data length
@@ -253,11 +253,11 @@ TEST_CASE("PNG has the signature and IHDR size", "[io][png]") {
 }
 
 TEST_CASE("atomic writes replace the target and clean up", "[io][atomic]") {
-  TempDir tmp;
+  IoDir tmp;
   const std::string path = tmp / "out.txt";
   write_text_atomically(path, "first");
   write_text_atomically(path, "second\n");
-  REQUIRE(slurp(path) == "second\n");
+  REQUIRE(slurp_io_file(path) == "second\n");
   REQUIRE(tmp.temporaries().empty());
 
   SECTION("the temporary sits next to the target and carries the pid") {
@@ -267,7 +267,7 @@ TEST_CASE("atomic writes replace the target and clean up", "[io][atomic]") {
       std::ofstream(t) << "third";
     });
     REQUIRE(seen == path + ".tmp." + std::to_string(::getpid()));
-    REQUIRE(slurp(path) == "third");
+    REQUIRE(slurp_io_file(path) == "third");
   }
   SECTION("a throwing writer leaves no temporary and the target unchanged") {
     REQUIRE_THROWS_WITH(write_atomically(path,
@@ -276,18 +276,18 @@ TEST_CASE("atomic writes replace the target and clean up", "[io][atomic]") {
                                            throw std::runtime_error("boom");
                                          }),
                         "boom");
-    REQUIRE(slurp(path) == "second\n");
+    REQUIRE(slurp_io_file(path) == "second\n");
     REQUIRE(tmp.temporaries().empty());
   }
   SECTION("a failing encoder (here a bad size) does not touch the target") {
     REQUIRE_THROWS_AS(write_png_rgb8(path, 0, 3, reinterpret_cast<const uint8_t*>("x")), RuntimeError);
-    REQUIRE(slurp(path) == "second\n");
+    REQUIRE(slurp_io_file(path) == "second\n");
     REQUIRE(tmp.temporaries().empty());
   }
 }
 
 TEST_CASE("writing into a missing directory throws RuntimeError naming the path", "[io][atomic]") {
-  TempDir tmp;
+  IoDir tmp;
   const std::string dir = tmp / "no/such/dir";
   const float f[12] = {};
   const uint8_t b[12] = {};

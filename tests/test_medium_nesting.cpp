@@ -17,8 +17,8 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-SceneDesc scene_with(const std::string& shapes,
-                     const std::string& camera_position = "[0, 0, 200]") {
+SceneDesc nesting_scene_with(const std::string& shapes,
+                             const std::string& camera_position = "[0, 0, 200]") {
   return load_scene_string(R"({
     "camera": { "type": "orthographic", "position": )" +
                                camera_position +
@@ -32,9 +32,9 @@ SceneDesc scene_with(const std::string& shapes,
                            "nesting.json", ".");
 }
 
-std::string load_error(const std::string& shapes) {
+std::string nesting_load_error(const std::string& shapes) {
   try {
-    scene_with(shapes);
+    nesting_scene_with(shapes);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -50,7 +50,7 @@ const char* kBoxA =
 // Catches: a wrong containment test (parity, sphere-in-box, box-in-sphere, a rotated box) or the
 // outermost instead of the innermost enclosing shape being chosen.
 TEST_CASE("enclosing shapes: spheres, boxes, rotated boxes, three levels, siblings", "[nesting]") {
-  const SceneDesc d = scene_with(std::string(kBoxA) + R"(,
+  const SceneDesc d = nesting_scene_with(std::string(kBoxA) + R"(,
     { "type": "sphere", "center": [0, 0, 0], "radius": 12, "medium": "b" },
     { "type": "box", "min": [-3, -3, -3], "max": [3, 3, 3], "transform": { "rotate": [20, 30, 40] },
       "material": { "type": "dielectric", "eta": 1.6 } },
@@ -75,30 +75,31 @@ TEST_CASE("enclosing shapes: spheres, boxes, rotated boxes, three levels, siblin
 // Catches: overlapping or touching medium shapes slipping through (their media would be
 // undefined), and messages that do not name both shapes.
 TEST_CASE("crossing or touching medium shapes are refused, naming both", "[nesting]") {
-  std::string msg =
-      load_error(std::string(kBoxA) +
-                 R"(, { "type": "box", "min": [20, 20, 0], "max": [40, 40, 10], "medium": "b" })");
+  std::string msg = nesting_load_error(
+      std::string(kBoxA) +
+      R"(, { "type": "box", "min": [20, 20, 0], "max": [40, 40, 10], "medium": "b" })");
   CHECK_THAT(msg, Contains("nesting.json: /shapes/0 and /shapes/1"));
   CHECK_THAT(msg, Contains("cross"));
-  msg = load_error(
+  msg = nesting_load_error(
       std::string(kBoxA) +
       R"(, { "type": "sphere", "center": [30, 0, 0], "radius": 5, "material": { "type": "dielectric" } })");
   CHECK_THAT(msg, Contains("/shapes/0 and /shapes/1"));
   CHECK_THAT(msg, Contains("cross"));
-  msg = load_error(R"({ "type": "sphere", "center": [0, 0, 0], "radius": 5, "medium": "a" },
+  msg = nesting_load_error(R"({ "type": "sphere", "center": [0, 0, 0], "radius": 5, "medium": "a" },
                       { "type": "sphere", "center": [10, 0, 0], "radius": 5, "medium": "b" })");
   CHECK_THAT(msg, Contains("touch"));
-  msg = load_error(
+  msg = nesting_load_error(
       std::string(kBoxA) +
       R"(, { "type": "box", "min": [30, -30, -20], "max": [50, 30, 20], "medium": "b" })");
   CHECK_THAT(msg, Contains("touch"));
   // A rotated box whose corners poke out of a sphere around it.
-  msg = load_error(R"({ "type": "sphere", "center": [0, 0, 0], "radius": 6, "medium": "a" },
+  msg = nesting_load_error(R"({ "type": "sphere", "center": [0, 0, 0], "radius": 6, "medium": "a" },
                       { "type": "box", "min": [-4, -4, -4], "max": [4, 4, 4], "transform": { "rotate": [0, 45, 0] },
                         "medium": "b" })");
   CHECK_THAT(msg, Contains("cross"));
   // Shapes without a medium may cross medium boundaries (a floor through fog).
-  CHECK_NOTHROW(scene_with(std::string(kBoxA) + R"(, { "type": "quad", "corner": [-50, -50, 0],
+  CHECK_NOTHROW(
+      nesting_scene_with(std::string(kBoxA) + R"(, { "type": "quad", "corner": [-50, -50, 0],
       "edge1": [100, 0, 0], "edge2": [0, 100, 0], "material": { "type": "diffuse", "albedo": 0.5 } })"));
 }
 
@@ -114,7 +115,7 @@ TEST_CASE("transmittance and time through nested media match the analytic answer
       "edge2": [0, 60, 0], "emission": 1 })";
   for (const bool camera_inside : {false, true}) {
     // Box b covers the left half of the film (x < 0).
-    SceneDesc d = scene_with(std::string(kBoxA) + R"(, { "type": "box", "min": [-25, -25, -5],
+    SceneDesc d = nesting_scene_with(std::string(kBoxA) + R"(, { "type": "box", "min": [-25, -25, -5],
         "max": [0, 25, 5], "medium": "b" })" +
                                  emitter,
                              camera_inside ? "[0, 0, 15]" : "[0, 0, 200]");

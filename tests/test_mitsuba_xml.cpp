@@ -58,7 +58,7 @@ std::string xml_scene(const std::string& body, const std::string& sensor_extra =
 }
 
 // The InputError message for `xml` (checked to be one line naming the file).
-std::string error_of(const std::string& xml) {
+std::string xml_error_of(const std::string& xml) {
   try {
     load_mitsuba_xml(xml, "bad.xml", ".");
   } catch (const InputError& e) {
@@ -307,7 +307,7 @@ TEST_CASE("mitsuba xml: a constant emitter is left out with a warning", "[mitsub
 // problem (file, line, element, attribute or value).
 TEST_CASE("mitsuba xml: bad input names the file, line and element", "[mitsuba]") {
   // Line 11 is the first line of `body` (xml_scene's layout).
-  const auto body_error = [](const std::string& body) { return error_of(xml_scene(body)); };
+  const auto body_error = [](const std::string& body) { return xml_error_of(xml_scene(body)); };
   CHECK_THAT(body_error("  <shape type=\"sphere\"><bsdf type=\"plastic\"/></shape>\n"),
              Contains("bad.xml:11: <bsdf type=\"plastic\">: unsupported bsdf \"plastic\""));
   CHECK_THAT(body_error("  <shape type=\"disk\"/>\n"),
@@ -359,33 +359,34 @@ TEST_CASE("mitsuba xml: bad input names the file, line and element", "[mitsuba]"
           "bad.xml:12: <emitter type=\"area\">: must be > 0 in some channel (got [0.0,0.0,0.0]) "
           "(femto scene key /shapes/0/emission)"));
   // Structure.
-  CHECK_THAT(error_of("<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n</scene>\n"),
+  CHECK_THAT(xml_error_of("<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n</scene>\n"),
              Contains("bad.xml:3: XML syntax error"));
-  CHECK_THAT(error_of("<scene>\n  <bogus/>\n</scene>\n"),
+  CHECK_THAT(xml_error_of("<scene>\n  <bogus/>\n</scene>\n"),
              Contains("bad.xml:2: <bogus>: unsupported element <bogus> at the scene level"));
-  CHECK_THAT(error_of("<scene>\n</scene>\n"),
+  CHECK_THAT(xml_error_of("<scene>\n</scene>\n"),
              Contains("bad.xml:1: <scene>: the scene has no <sensor>"));
   std::string dark = xml_scene("");
   const std::size_t e0 = dark.find("  <emitter"), e1 = dark.find("</emitter>\n") + 11;
   dark.erase(e0, e1 - e0);
-  CHECK_THAT(error_of(dark), Contains("bad.xml:1: <scene>: the scene has no emitter"));
+  CHECK_THAT(xml_error_of(dark), Contains("bad.xml:1: <scene>: the scene has no emitter"));
   // A constant emitter alone: left out (infinite arrival time), so there is no light.
   dark.insert(dark.find("</scene>"), "  <emitter type=\"constant\"/>\n");
-  CHECK_THAT(error_of(dark), Contains("a constant emitter adds nothing to the time bins"));
+  CHECK_THAT(xml_error_of(dark), Contains("a constant emitter adds nothing to the time bins"));
   std::string steady = xml_scene("");
   steady.replace(steady.find("transient_hdr_film"), 18, "hdrfilm");
-  CHECK_THAT(error_of(steady),
+  CHECK_THAT(xml_error_of(steady),
              Contains("bad.xml:5: <film type=\"hdrfilm\">: unsupported film \"hdrfilm\""));
-  CHECK_THAT(error_of(xml_scene("  <integrator type=\"path\"/>\n")),
+  CHECK_THAT(xml_error_of(xml_scene("  <integrator type=\"path\"/>\n")),
              Contains("bad.xml:11: <integrator type=\"path\">: unsupported integrator \"path\""));
-  CHECK_THAT(error_of(xml_scene("  <integrator type=\"transient_path\"><integer name=\"max_depth\" "
-                                "value=\"1\"/></integrator>\n")),
-             Contains("bad.xml:11: <integer name=\"max_depth\">: max_depth must be -1 (no bound) "
-                      "or in [2, 1000001]"));
+  CHECK_THAT(
+      xml_error_of(xml_scene("  <integrator type=\"transient_path\"><integer name=\"max_depth\" "
+                             "value=\"1\"/></integrator>\n")),
+      Contains("bad.xml:11: <integer name=\"max_depth\">: max_depth must be -1 (no bound) "
+               "or in [2, 1000001]"));
   // Names become JSON strings: bytes that are not UTF-8 are refused (a fuzzer finding).
-  CHECK_THAT(error_of("<scene>\n  <shape id=\"a\xff\"/>\n</scene>\n"),
+  CHECK_THAT(xml_error_of("<scene>\n  <shape id=\"a\xff\"/>\n</scene>\n"),
              Contains("bad.xml:2: the file is not valid UTF-8"));
-  CHECK_THAT(error_of(xml_scene(
+  CHECK_THAT(xml_error_of(xml_scene(
                  "  <shape type=\"obj\"><string name=\"filename\" value=\"\xc3\"/></shape>\n")),
              Contains("bad.xml:11: the file is not valid UTF-8"));
   // The error type is InputError (exit code 2 in the CLI).
@@ -395,7 +396,7 @@ TEST_CASE("mitsuba xml: bad input names the file, line and element", "[mitsuba]"
 
 // Catches: a reference cycle recursing without end.
 TEST_CASE("mitsuba xml: a reference cycle is an error", "[mitsuba]") {
-  CHECK_THAT(error_of(xml_scene("  <bsdf type=\"twosided\" id=\"a\"><ref id=\"a\"/></bsdf>\n"
+  CHECK_THAT(xml_error_of(xml_scene("  <bsdf type=\"twosided\" id=\"a\"><ref id=\"a\"/></bsdf>\n"
                                 "  <shape type=\"sphere\"><ref id=\"a\"/></shape>\n")),
              Contains("references nest too deep"));
 }

@@ -14,9 +14,9 @@ TEST_CASE("obj loader: faces, indices and errors", "[obj_loader]") {
   std::vector<Vec3> v;
   std::vector<std::array<uint32_t, 3>> t;
 
-  femto::load_obj(write_file("pent.obj",
-                             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 1.5 0\nv +0 1 -0e0\n"
-                             "g poly\nf 1 2 3 4 5\nl 1 2\n"),
+  femto::load_obj(write_temp_file("pent.obj",
+                                  "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 1.5 0\nv +0 1 -0e0\n"
+                                  "g poly\nf 1 2 3 4 5\nl 1 2\n"),
                   v, t);
   REQUIRE(v.size() == 5);
   CHECK(v[3].x == 0.5);
@@ -24,16 +24,16 @@ TEST_CASE("obj loader: faces, indices and errors", "[obj_loader]") {
   CHECK(t[0] == std::array<uint32_t, 3>{0, 1, 2});
   CHECK(t[2] == std::array<uint32_t, 3>{0, 3, 4});
 
-  femto::load_obj(write_file("tet.obj", kTetObj), v, t);
+  femto::load_obj(write_temp_file("tet.obj", kTetObj), v, t);
   REQUIRE(t.size() == 4);
   CHECK(t[2] == std::array<uint32_t, 3>{0, 3, 2});  // from negative indices
 
   // Forward references are allowed as long as the vertex exists by the end of the file.
-  femto::load_obj(write_file("fwd.obj", "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"), v, t);
+  femto::load_obj(write_temp_file("fwd.obj", "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"), v, t);
   CHECK(t.size() == 1);
 
   auto error = [&](const std::string& name, const std::string& text) -> std::string {
-    const std::string path = write_file(name, text);
+    const std::string path = write_temp_file(name, text);
     try {
       femto::load_obj(path, v, t);
     } catch (const InputError& e) {

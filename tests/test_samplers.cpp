@@ -28,7 +28,7 @@ namespace st = femto::stats;
 
 namespace {
 
-constexpr double kAlpha = 1e-3;  // reject when p < kAlpha
+constexpr double kSamplerAlpha = 1e-3;  // reject when p < kSamplerAlpha
 
 struct Point2 {
   double x, y;
@@ -120,7 +120,7 @@ TEST_CASE("HG sampling matches hg_eval (chi-square over cos theta x phi)", "[sam
     const st::Chi2Result r = hg_chi2(g, g, seed++);
     INFO("g = " << g << "  chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value
                 << "  pooled = " << r.cells_pooled);
-    CHECK(r.p_value >= kAlpha);
+    CHECK(r.p_value >= kSamplerAlpha);
   }
 }
 
@@ -189,7 +189,7 @@ TEST_CASE("Exponential distance sampling matches exponential_pdf", "[samplers][d
     const st::Chi2Result r = st::chi2_test(observed, expected);
     INFO("sigma_t = " << sigma_t << "  chi2 = " << r.chi2 << "  dof = " << r.dof
                       << "  p = " << r.p_value);
-    CHECK(r.p_value >= kAlpha);
+    CHECK(r.p_value >= kSamplerAlpha);
   }
 }
 
@@ -223,7 +223,7 @@ TEST_CASE("Cosine hemisphere warp matches its pdf", "[samplers][warps]") {
       integrated([](double mu, double) { return femto::cosine_hemisphere_pdf(mu); }), -1.0, 1.0,
       20, 0.0, 2.0 * kPi, 20, 200000, 21);
   INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
-  CHECK(r.p_value >= kAlpha);
+  CHECK(r.p_value >= kSamplerAlpha);
 }
 
 // Catches a uniform-sphere warp that clusters at the poles (e.g. z = cos(pi u1)) or a bad azimuth.
@@ -237,7 +237,7 @@ TEST_CASE("Uniform sphere warp is uniform", "[samplers][warps]") {
       integrated([](double, double) { return 1.0 / (4.0 * kPi); }), -1.0, 1.0, 40, 0.0,
       2.0 * kPi, 20, 200000, 22);
   INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
-  CHECK(r.p_value >= kAlpha);
+  CHECK(r.p_value >= kSamplerAlpha);
 }
 
 // Catches direction samplers whose output drifts off the unit sphere beyond rounding (an azimuth
@@ -284,7 +284,7 @@ TEST_CASE("Uniform disc warp is uniform", "[samplers][warps]") {
       [](double xa, double xb, double ya, double yb) { return (xb - xa) * (yb - ya) / (2 * kPi); },
       0.0, 1.0, 20, 0.0, 2.0 * kPi, 20, 100000, 23);
   INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
-  CHECK(r.p_value >= kAlpha);
+  CHECK(r.p_value >= kSamplerAlpha);
 }
 
 // Catches barycentrics that cluster at a vertex (e.g. b1 = 1 - u1) or fall outside the triangle.
@@ -306,7 +306,7 @@ TEST_CASE("Uniform triangle barycentrics are uniform", "[samplers][warps]") {
       },
       0.0, 1.0, K, 0.0, 1.0, K, 200000, 24);
   INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
-  CHECK(r.p_value >= kAlpha);
+  CHECK(r.p_value >= kSamplerAlpha);
 }
 
 // ---- Sanity of the statistics themselves (a broken chi2 must not silently pass) ----
@@ -390,7 +390,7 @@ TEST_CASE("Kolmogorov-Smirnov statistic and p-value", "[stats]") {
   const double p_uniform = st::ks_p_value(st::ks_statistic_uniform(uniform, 0.0, 1.0), n);
   const double p_skewed = st::ks_p_value(st::ks_statistic_uniform(skewed, 0.0, 1.0), n);
   INFO("p(uniform) = " << p_uniform << "  p(u^1.2) = " << p_skewed);
-  CHECK(p_uniform >= kAlpha);
+  CHECK(p_uniform >= kSamplerAlpha);
   CHECK(p_skewed < 1e-6);
 }
 

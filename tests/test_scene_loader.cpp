@@ -419,19 +419,19 @@ TEST_CASE("scene loader: mesh files", "[scene_loader]") {
   CHECK_THAT(error_of(j),
              Contains("/shapes/3/file") && Contains("not found") && Contains("(got \"nope.obj\")"));
 
-  write_file("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n");
+  write_temp_file("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n");
   j["shapes"][3]["file"] = "bad.obj";
   CHECK_THAT(error_of(j),
              Contains("/shapes/3/file") && Contains("bad.obj:3:") && Contains("'zero'"));
 
   // A medium needs a closed surface: one face of the tetrahedron is missing.
-  write_file("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n");
+  write_temp_file("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n");
   j["shapes"][3]["file"] = "open.obj";
   CHECK_THAT(error_of(j), Contains("/shapes/3/file") && Contains("not closed"));
 
   // Inward-facing winding is rejected for a medium-bearing mesh.
-  write_file("inward.obj",
-             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n");
+  write_temp_file("inward.obj",
+                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n");
   j["shapes"][3]["file"] = "inward.obj";
   CHECK_THAT(error_of(j), Contains("/shapes/3/file") && Contains("inward"));
 }

@@ -12,7 +12,7 @@ namespace {
 
 // A VDB medium named "cloud" (the loader only checks that its file exists; it never parses it).
 Json vdb_scene(const Json& cloud) {
-  write_file("cloud.vdb", "not parsed by the loader");
+  write_temp_file("cloud.vdb", "not parsed by the loader");
   Json j = base_scene();
   j["media"]["cloud"] = cloud;
   j["shapes"].push_back(
@@ -101,7 +101,7 @@ TEST_CASE("scene loader: rough dielectric and rough conductor materials", "[scen
   k["shapes"][2]["medium"] = "fog";  // rough conductor box
   k["shapes"][2]["material"] = {{"type", "rough_conductor"}};
   CHECK_THAT(error_of(k), Contains("/shapes/2/medium") && Contains("opaque"));
-  write_file("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n");
+  write_temp_file("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n");
   k = j;
   k["shapes"][3]["file"] = "open.obj";
   k["shapes"][3].erase("medium");

@@ -81,7 +81,7 @@ struct Loaded {
   VolumeData data;
   GridMedium medium;
 };
-Loaded load(const VdbMediumDesc& d) {
+Loaded load_sparse(const VdbMediumDesc& d) {
   VolumeData v = load_volume(d, "scene.json", "/media/m");
   GridMedium m(v, d);
   return {std::move(v), std::move(m)};
@@ -95,7 +95,7 @@ std::vector<MediumSegment> walk(const GridMedium& m, const Ray& ray, double s_ma
   return out;
 }
 
-bool same_bits(const MediumSegment& a, const MediumSegment& b) {
+bool same_sparse_bits(const MediumSegment& a, const MediumSegment& b) {
   if (a.s0 != b.s0 || a.s1 != b.s1) return false;
   for (int i = 0; i < 4; ++i)
     if (a.sigma_t.c[i] != b.sigma_t.c[i] || a.eta.c[i] != b.eta.c[i]) return false;
@@ -113,7 +113,7 @@ Ray random_ray(Rng& rng, const Vec3& lo, const Vec3& hi, double& s_max) {
   return Ray{o, normalize(t - o)};
 }
 
-TimeAxis axis_of(double t0, double width, int bins) {
+TimeAxis grid_axis_of(double t0, double width, int bins) {
   TimeAxis a;
   a.t_start_ps = t0;
   a.bin_width_ps = width;
@@ -134,8 +134,8 @@ TEST_CASE("sparse and dense walks are bit-identical on an aligned volume", "[spa
   const RandomVolume rv = random_volume(150, 13, 17, 3, 60, 90);
   const std::string file = write_random((tmp.dir / "aligned.vdb").string(), rv, {0, 0, 0});
   for (bool trilinear : {false, true}) {
-    const Loaded dense = load(desc_of(file, trilinear, VdbMediumDesc::Storage::Dense));
-    const Loaded sparse = load(desc_of(file, trilinear, VdbMediumDesc::Storage::Sparse));
+    const Loaded dense = load_sparse(desc_of(file, trilinear, VdbMediumDesc::Storage::Dense));
+    const Loaded sparse = load_sparse(desc_of(file, trilinear, VdbMediumDesc::Storage::Sparse));
     REQUIRE(!dense.medium.sparse());
     REQUIRE(sparse.medium.sparse());
     CHECK(sparse.medium.max_sigma_t() == dense.medium.max_sigma_t());
@@ -162,7 +162,7 @@ TEST_CASE("sparse and dense walks are bit-identical on an aligned volume", "[spa
              << "seg " << i << " d " << a[i].s0 << " " << a[i].s1 << " " << a[i].sigma_t.c[0] << " "
              << a[i].eta.c[0] << " s " << b[i].s0 << " " << b[i].s1 << " " << b[i].sigma_t.c[0]
              << " " << b[i].eta.c[0]);
-        REQUIRE(same_bits(a[i], b[i]));
+        REQUIRE(same_sparse_bits(a[i], b[i]));
       }
       segments += static_cast<int>(a.size());
       const Vec3 p = ray.at(s_max * rng.uniform());
@@ -184,8 +184,8 @@ TEST_CASE("sparse and dense integrals agree on a misaligned volume with empty no
   const RandomVolume rv = random_volume(400, 9, 11, 5, 100, 350);
   const std::string file = write_random((tmp.dir / "offset.vdb").string(), rv, {-133, 45, 7});
   for (bool trilinear : {false, true}) {
-    const Loaded dense = load(desc_of(file, trilinear, VdbMediumDesc::Storage::Dense));
-    const Loaded sparse = load(desc_of(file, trilinear, VdbMediumDesc::Storage::Sparse));
+    const Loaded dense = load_sparse(desc_of(file, trilinear, VdbMediumDesc::Storage::Dense));
+    const Loaded sparse = load_sparse(desc_of(file, trilinear, VdbMediumDesc::Storage::Sparse));
     Rng rng(23, 1);
     const Vec3 lo = dense.data.world_bounds_min, hi = dense.data.world_bounds_max;
     size_t dense_segments = 0, sparse_segments = 0;
@@ -226,11 +226,12 @@ TEST_CASE("sparse and dense integrals agree on a misaligned volume with empty no
 
 // Catches: the automatic rule changing existing scenes (small volumes stay dense), a sparse
 // volume spending memory on its empty box, tiles (constant regions) read wrong.
-TEST_CASE("auto storage: small volumes stay dense, far-apart voxels load sparse", "[sparse]") {
+TEST_CASE("auto storage: small volumes stay dense, far-apart voxels load_sparse sparse",
+          "[sparse]") {
   TempDir tmp("femto_sparse");
   const RandomVolume rv = random_volume(12, 12, 12, 9);
   const std::string small = write_random((tmp.dir / "small.vdb").string(), rv, {0, 0, 0});
-  CHECK(!load(desc_of(small, true, VdbMediumDesc::Storage::Auto)).medium.sparse());
+  CHECK(!load_sparse(desc_of(small, true, VdbMediumDesc::Storage::Auto)).medium.sparse());
 
   // Two constant 64^3 blocks (stored as tiles after pruning) 30000 voxels apart: a dense box of
   // 30064 x 64 x 64 cells (470 MiB for one grid), a few MiB sparse.
@@ -248,7 +249,7 @@ TEST_CASE("auto storage: small volumes stay dense, far-apart voxels load sparse"
   VdbMediumDesc d;
   d.file = far;
   d.sigma_t_scale = 2.0;
-  const Loaded l = load(d);
+  const Loaded l = load_sparse(d);
   REQUIRE(l.medium.sparse());
   CHECK(l.data.memory_bytes() < (8u << 20));
   CHECK(l.data.sparse->tile_count > 0);
@@ -338,7 +339,7 @@ TEST_CASE("dense and sparse renders agree bin by bin", "[sparse][statistical]") 
     SceneDesc d;
     d.source = "voxels";
     d.camera = perspective({0, 30, 130}, {0, 25, 0}, 50, 16, 12);
-    d.time = axis_of(300, 100, 10);
+    d.time = grid_axis_of(300, 100, 10);
     d.media.push_back(m);
     d.global_medium = 0;
     d.shapes.push_back(quad({-60, 0, 60}, {120, 0, 0}, {0, 0, -120}, diffuse(0.6)));

@@ -32,8 +32,8 @@ namespace st = femto::stats;
 
 namespace {
 
-constexpr double kAlpha = 1e-3;  // reject when p < kAlpha
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kTimeSamplerAlpha = 1e-3;  // reject when p < kTimeSamplerAlpha
+using femto::kInf;
 constexpr int kSamples = 100000;  // per chi-square test
 
 /// Chi-square of n draws on [lo, hi] in `bins` equal bins against n times the pdf integrated
@@ -123,7 +123,7 @@ TEST_CASE("equiangular: samples follow the pdf, pdf normalised, CDF round trip",
     const st::Chi2Result r = chi2_1d([&](Rng& rng) { return eq.sample(rng.uniform()); }, pdf, s_a,
                                      s_b, 50, seed++, {eq.delta()});
     INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
-    CHECK(r.p_value >= kAlpha);
+    CHECK(r.p_value >= kTimeSamplerAlpha);
     double worst = 0;
     for (int k = 0; k <= 1000; ++k) {
       const double u = k / 1000.0;
@@ -176,7 +176,7 @@ TEST_CASE("line-to-point: samples follow the pdf, pdf normalised, round trips",
         chi2_1d([&](Rng& rng) { return ltp.sample(win, rng.uniform()); },
                 [&](double s) { return ltp.pdf(win, s); }, win.s_a, win.s_b, 50, seed++, {delta});
     INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
-    CHECK(r.p_value >= kAlpha);
+    CHECK(r.p_value >= kTimeSamplerAlpha);
     // Round trips: the time of sample(u) is linear in u; s(L(s)) = s past the dead zone.
     const double t_lo = c.eta * win.L_a / kSpeedOfLight, t_hi = c.eta * win.L_b / kSpeedOfLight;
     double worst_t = 0, worst_s = 0;
@@ -267,7 +267,7 @@ TEST_CASE("angular: directions follow the pdf over (theta, phi), pdf normalised"
     }
     const st::Chi2Result r = st::chi2_test(observed, expected);
     INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
-    CHECK(r.p_value >= kAlpha);
+    CHECK(r.p_value >= kTimeSamplerAlpha);
   }
 }
 
@@ -362,8 +362,8 @@ TEST_CASE("line-to-point times are uniform; mfp and equiangular are not",
   INFO("line-to-point p = " << u_ltp.chi2_p << ", " << u_ltp.ks_p << "; mfp (" << t_mfp.size()
                             << " in window) p = " << u_mfp.chi2_p << ", " << u_mfp.ks_p
                             << "; equiangular p = " << u_eq.chi2_p << ", " << u_eq.ks_p);
-  CHECK(u_ltp.chi2_p >= kAlpha);
-  CHECK(u_ltp.ks_p >= kAlpha);
+  CHECK(u_ltp.chi2_p >= kTimeSamplerAlpha);
+  CHECK(u_ltp.ks_p >= kTimeSamplerAlpha);
   CHECK(t_mfp.size() > 1000);
   CHECK(u_mfp.chi2_p < 1e-6);
   CHECK(u_mfp.ks_p < 1e-6);
@@ -394,8 +394,8 @@ TEST_CASE("angular connection times are uniform; uniform-sphere directions are n
     const Uniformity ui = uniformity_of(t_iso, ang.t_min(), ang.t_max());
     INFO("r = " << r << "  angular p = " << ua.chi2_p << ", " << ua.ks_p
                 << "  uniform sphere p = " << ui.chi2_p << ", " << ui.ks_p);
-    CHECK(ua.chi2_p >= kAlpha);
-    CHECK(ua.ks_p >= kAlpha);
+    CHECK(ua.chi2_p >= kTimeSamplerAlpha);
+    CHECK(ua.ks_p >= kTimeSamplerAlpha);
     CHECK(ui.chi2_p < 1e-6);
     CHECK(ui.ks_p < 1e-6);
   }

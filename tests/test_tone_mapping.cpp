@@ -25,7 +25,7 @@ using namespace femto;
 
 namespace {
 
-std::string slurp(const std::string& path) {
+std::string slurp_image_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
@@ -95,7 +95,7 @@ TEST_CASE("global tone mapping reproduces the previous contact sheet bit for bit
   const ToneMapSettings global;  // the default
   const std::vector<ToneCurve> curves = frame_tone_curves(film, global);
   write_contact_sheet(now, film, global, curves);
-  REQUIRE(slurp(before) == slurp(now));
+  REQUIRE(slurp_image_file(before) == slurp_image_file(now));
   // And one linear curve maps exactly like tonemap_srgb8 with its scale.
   const std::vector<float> f = film.frame(7);
   REQUIRE(tone_map_rgb8(f.data(), f.size() / 3, curves[7]) ==

@@ -37,46 +37,47 @@ un::Config small_config() {
   return c;
 }
 
-std::string read_text(const fs::path& p) {
+std::string read_uniformity_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-std::string quote(const std::string& s) {
+std::string shell_quote(const std::string& s) {
   std::string q = "'";
   for (char ch : s) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
   return q + "'";
 }
 
-struct Run {
+struct UniformityRun {
   int code = -1;
   std::string out, err;
 };
 
 // Runs femto uniformity with `args` from folder `cwd`; output captured under `logs`.
-Run run_uniformity(const std::vector<std::string>& args, const fs::path& cwd,
-                   const fs::path& logs) {
+UniformityRun run_uniformity(const std::vector<std::string>& args, const fs::path& cwd,
+                             const fs::path& logs) {
   fs::create_directories(logs);
-  std::string cmd = quote(FEMTO_BINARY) + " uniformity";
-  for (const auto& a : args) cmd += " " + quote(a);
+  std::string cmd = shell_quote(FEMTO_BINARY) + " uniformity";
+  for (const auto& a : args) cmd += " " + shell_quote(a);
   const fs::path out = logs / "stdout.txt", err = logs / "stderr.txt";
-  const std::string full = "cd " + quote(cwd.string()) + " && " + cmd + " >" + quote(out.string()) +
-                           " 2>" + quote(err.string()) + " </dev/null";
+  const std::string full = "cd " + shell_quote(cwd.string()) + " && " + cmd + " >" +
+                           shell_quote(out.string()) + " 2>" + shell_quote(err.string()) +
+                           " </dev/null";
   const int status = std::system(full.c_str());
-  Run r;
+  UniformityRun r;
   if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
-  r.out = read_text(out);
-  r.err = read_text(err);
+  r.out = read_uniformity_file(out);
+  r.err = read_uniformity_file(err);
   return r;
 }
 
-std::set<std::string> listing(const fs::path& dir) {
+std::set<std::string> uniformity_listing(const fs::path& dir) {
   std::set<std::string> names;
   for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
   return names;
 }
 
-bool contains(const std::string& s, const std::string& part) {
+bool listing_contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;
 }
 
@@ -162,17 +163,17 @@ TEST_CASE("uniformity: an unreachable window is reported invalid", "[uniformity]
 TEST_CASE("uniformity cli: default run writes the table, CSVs, JSON and PNG", "[uniformity][cli]") {
   femto::test::TempDir tmp("femto_test_uniformity");
   const fs::path out = tmp.dir / "out";
-  const Run r = run_uniformity({"--samples", "20000", "--bins", "40", "--out", out.string()},
+  const UniformityRun r = run_uniformity({"--samples", "20000", "--bins", "40", "--out", out.string()},
                                tmp.dir, tmp.dir / "logs");
   INFO(r.err);
   REQUIRE(r.code == 0);
   for (un::Strategy s : un::all_strategies()) {
     const std::string name = un::strategy_name(s);
-    CHECK(contains(r.out, name));
-    const std::string csv = read_text(out / ("hist_" + name + ".csv"));
+    CHECK(listing_contains(r.out, name));
+    const std::string csv = read_uniformity_file(out / ("hist_" + name + ".csv"));
     CHECK(std::count(csv.begin(), csv.end(), '\n') == 41);  // header + 40 bins
   }
-  const json j = json::parse(read_text(out / "summary.json"));
+  const json j = json::parse(read_uniformity_file(out / "summary.json"));
   REQUIRE(j["strategies"].size() == 5);
   for (const auto& s : j["strategies"]) {
     CHECK(s["in_range"].get<double>() > 0);
@@ -182,7 +183,7 @@ TEST_CASE("uniformity cli: default run writes the table, CSVs, JSON and PNG", "[
   }
   CHECK(fs::file_size(out / "histograms.png") > 1000);
   for (const auto& e : fs::directory_iterator(out))  // atomic writes leave no temporaries
-    CHECK_FALSE(contains(e.path().filename().string(), ".tmp"));
+    CHECK_FALSE(listing_contains(e.path().filename().string(), ".tmp"));
 }
 
 // Catches --expect uniform ignoring failures (or failing passing strategies).
@@ -196,7 +197,7 @@ TEST_CASE("uniformity cli: --expect uniform exit codes", "[uniformity][cli]") {
   for (const Case c : {Case{"line_to_point", 0}, Case{"angular", 0}, Case{"time_uniform", 0},
                        Case{"mfp", 1}, Case{"equiangular", 1}, Case{"all", 1}}) {
     const fs::path out = tmp.dir / ("out" + std::to_string(k));
-    const Run r = run_uniformity({"--strategy", c.strategy, "--samples", "20000", "--expect",
+    const UniformityRun r = run_uniformity({"--strategy", c.strategy, "--samples", "20000", "--expect",
                                   "uniform", "--quiet", "--out", out.string()},
                                  tmp.dir, tmp.dir / ("logs" + std::to_string(k)));
     ++k;
@@ -238,22 +239,22 @@ TEST_CASE("uniformity cli: bad flags exit 2 with one message and write nothing",
       {"an unknown flag", {"--bogus"}, {"--bogus"}},
       {"a non-numeric number", {"--t-end", "abc"}, {"--t-end", "'abc'"}},
   };
-  const std::set<std::string> before = listing(work);
+  const std::set<std::string> before = uniformity_listing(work);
   int index = 0;
   for (const auto& c : cases) {
     std::vector<std::string> args = c.args;
     args.push_back("--out");
     args.push_back(out);
-    const Run r = run_uniformity(args, work, tmp.dir / ("logs" + std::to_string(index++)));
+    const UniformityRun r = run_uniformity(args, work, tmp.dir / ("logs" + std::to_string(index++)));
     INFO("case: " << c.what << "\nstderr: " << r.err);
     CHECK(r.code == 2);
     CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
     for (const auto& e : c.expect) {
       INFO("message should contain " << e);
-      CHECK(contains(r.err, e));
+      CHECK(listing_contains(r.err, e));
     }
     CHECK(r.out.empty());
     CHECK_FALSE(fs::exists(out));
-    CHECK(listing(work) == before);
+    CHECK(uniformity_listing(work) == before);
   }
 }

@@ -46,7 +46,7 @@ VdbMediumDesc desc_for(const std::string& file) {
 }
 
 // Loads and returns the InputError message ("" if it loaded).
-std::string load_error(const VdbMediumDesc& d) {
+std::string volume_load_error(const VdbMediumDesc& d) {
   try {
     load_volume(d, "scene.json", "/media/m");
   } catch (const InputError& e) {
@@ -99,7 +99,7 @@ TEST_CASE("bad volumes give one clear error each", "[vdb]") {
   DenseGrid ok(4, 4, 4, 0.5f);
   ok.update_range();
   SECTION("missing file") {
-    const std::string msg = load_error(desc_for(vol_path("nope.vdb")));
+    const std::string msg = volume_load_error(desc_for(vol_path("nope.vdb")));
     CHECK_THAT(msg, Catch::Contains("nope.vdb") && Catch::Contains("not found") && Catch::Contains("/media/m"));
   }
   SECTION("not a VDB file") {
@@ -107,12 +107,13 @@ TEST_CASE("bad volumes give one clear error each", "[vdb]") {
     FILE* fp = std::fopen(f.c_str(), "w");
     std::fputs("hello", fp);
     std::fclose(fp);
-    CHECK_THAT(load_error(desc_for(f)), Catch::Contains("text.vdb") && Catch::Contains("OpenVDB"));
+    CHECK_THAT(volume_load_error(desc_for(f)),
+               Catch::Contains("text.vdb") && Catch::Contains("OpenVDB"));
   }
   SECTION("grid name not found lists the grids") {
     const std::string f = vol_path("names.vdb");
     write_volume(f, ok, nullptr, nullptr, 1.0, {0, 0, 0}, "smoke");
-    CHECK_THAT(load_error(desc_for(f)), Catch::Contains("'density'") && Catch::Contains("smoke"));
+    CHECK_THAT(volume_load_error(desc_for(f)), Catch::Contains("'density'") && Catch::Contains("smoke"));
   }
   SECTION("wrong grid type") {
     const std::string f = vol_path("double.vdb");
@@ -121,7 +122,7 @@ TEST_CASE("bad volumes give one clear error each", "[vdb]") {
     g.values = &ok;
     g.type = VdbGridSpec::Type::Double;
     write_vdb(f, {g});
-    CHECK_THAT(load_error(desc_for(f)), Catch::Contains("density") && Catch::Contains("double"));
+    CHECK_THAT(volume_load_error(desc_for(f)), Catch::Contains("density") && Catch::Contains("double"));
   }
   SECTION("level set class") {
     const std::string f = vol_path("levelset.vdb");
@@ -130,7 +131,7 @@ TEST_CASE("bad volumes give one clear error each", "[vdb]") {
     g.values = &ok;
     g.grid_class = VdbGridSpec::Class::LevelSet;
     write_vdb(f, {g});
-    CHECK_THAT(load_error(desc_for(f)), Catch::Contains("level set"));
+    CHECK_THAT(volume_load_error(desc_for(f)), Catch::Contains("level set"));
   }
   SECTION("frustum transform") {
     const std::string f = vol_path("frustum.vdb");
@@ -139,14 +140,14 @@ TEST_CASE("bad volumes give one clear error each", "[vdb]") {
     g.values = &ok;
     g.frustum = true;
     write_vdb(f, {g});
-    CHECK_THAT(load_error(desc_for(f)), Catch::Contains("non-linear"));
+    CHECK_THAT(volume_load_error(desc_for(f)), Catch::Contains("non-linear"));
   }
   SECTION("negative density names the voxel and the value") {
     DenseGrid bad = ok;
     bad.at(1, 2, 3) = -0.25f;
     const std::string f = vol_path("negative.vdb");
     write_volume(f, bad, nullptr, nullptr, 1.0, {0, 0, 0});
-    CHECK_THAT(load_error(desc_for(f)), Catch::Contains("(1, 2, 3)") && Catch::Contains("-0.25") &&
+    CHECK_THAT(volume_load_error(desc_for(f)), Catch::Contains("(1, 2, 3)") && Catch::Contains("-0.25") &&
                                             Catch::Contains("density must be >= 0"));
   }
   SECTION("eta below 1") {
@@ -156,7 +157,7 @@ TEST_CASE("bad volumes give one clear error each", "[vdb]") {
     write_volume(f, ok, nullptr, &eta, 1.0, {0, 0, 0});
     VdbMediumDesc d = desc_for(f);
     d.eta_grid = "eta";
-    CHECK_THAT(load_error(d), Catch::Contains("eta must be >= 1") && Catch::Contains("0.75") &&
+    CHECK_THAT(volume_load_error(d), Catch::Contains("eta must be >= 1") && Catch::Contains("0.75") &&
                                   Catch::Contains("(0, 1, 2)"));
   }
   SECTION("albedo above 1") {
@@ -166,7 +167,7 @@ TEST_CASE("bad volumes give one clear error each", "[vdb]") {
     write_volume(f, ok, &albedo, nullptr, 1.0, {0, 0, 0});
     VdbMediumDesc d = desc_for(f);
     d.albedo_grid = "albedo";
-    CHECK_THAT(load_error(d), Catch::Contains("albedo must be in [0, 1]") && Catch::Contains("1.5"));
+    CHECK_THAT(volume_load_error(d), Catch::Contains("albedo must be in [0, 1]") && Catch::Contains("1.5"));
   }
 }
 
@@ -202,44 +203,44 @@ TEST_CASE("bad volumes: transforms, backgrounds, non-finite values, sizes", "[vd
     VdbGridSpec e = grid_spec("eta", eta);
     e.voxel_mm = Vec3(0.5);
     write({grid_spec("density", ok), e});
-    CHECK_THAT(load_error(d), Catch::Contains("/media/m/eta_grid: ") && Catch::Contains("voxel size") &&
+    CHECK_THAT(volume_load_error(d), Catch::Contains("/media/m/eta_grid: ") && Catch::Contains("voxel size") &&
                                   Catch::Contains("[0.5, 0.5, 0.5]"));
   }
   SECTION("eta grid with another offset") {
     VdbGridSpec e = grid_spec("eta", eta);
     e.origin_mm = {0.25, 0, 0};
     write({grid_spec("density", ok), e});
-    CHECK_THAT(load_error(d), Catch::Contains("offset") && Catch::Contains("'eta'"));
+    CHECK_THAT(volume_load_error(d), Catch::Contains("offset") && Catch::Contains("'eta'"));
   }
   SECTION("density background must be 0") {
     write({grid_spec("density", ok, 0.25f)});
-    CHECK_THAT(load_error(desc_for(d.file)), Catch::Contains("background must be 0") && Catch::Contains("0.25"));
+    CHECK_THAT(volume_load_error(desc_for(d.file)), Catch::Contains("background must be 0") && Catch::Contains("0.25"));
   }
   SECTION("eta background below 1") {
     write({grid_spec("density", ok), grid_spec("eta", eta, 0.5f)});
-    CHECK_THAT(load_error(d), Catch::Contains("'eta' background") && Catch::Contains("(got 0.5)"));
+    CHECK_THAT(volume_load_error(d), Catch::Contains("'eta' background") && Catch::Contains("(got 0.5)"));
   }
   SECTION("non-finite density") {
     DenseGrid bad = ok;
     bad.at(2, 0, 1) = std::numeric_limits<float>::quiet_NaN();
     write({grid_spec("density", bad)});
-    CHECK_THAT(load_error(desc_for(d.file)), Catch::Contains("(2, 0, 1)") && Catch::Contains("must be finite"));
+    CHECK_THAT(volume_load_error(desc_for(d.file)), Catch::Contains("(2, 0, 1)") && Catch::Contains("must be finite"));
   }
   SECTION("non-finite eta") {
     DenseGrid bad = eta;
     bad.at(1, 1, 1) = std::numeric_limits<float>::infinity();
     write({grid_spec("density", ok), grid_spec("eta", bad)});
-    CHECK_THAT(load_error(d), Catch::Contains("grid 'eta' voxel (1, 1, 1): eta must be finite (got inf)"));
+    CHECK_THAT(volume_load_error(d), Catch::Contains("grid 'eta' voxel (1, 1, 1): eta must be finite (got inf)"));
   }
   SECTION("empty density") {
     write({grid_spec("density", DenseGrid(4, 4, 4, 0.0f))});
-    CHECK_THAT(load_error(desc_for(d.file)), Catch::Contains("no active voxels"));
+    CHECK_THAT(volume_load_error(desc_for(d.file)), Catch::Contains("no active voxels"));
   }
   SECTION("wrong grid type for eta names the type") {
     VdbGridSpec e = grid_spec("eta", eta);
     e.type = VdbGridSpec::Type::Double;
     write({grid_spec("density", ok), e});
-    CHECK_THAT(load_error(d), Catch::Contains("/media/m/eta_grid") && Catch::Contains("double") &&
+    CHECK_THAT(volume_load_error(d), Catch::Contains("/media/m/eta_grid") && Catch::Contains("double") &&
                                   Catch::Contains("FloatGrid"));
   }
   SECTION("dense box above 2^30 cells") {
@@ -250,7 +251,7 @@ TEST_CASE("bad volumes: transforms, backgrounds, non-finite values, sizes", "[vd
     e.origin_mm = e.index_offset;  // same transform as the density grid (voxel 1 mm)
     write({grid_spec("density", DenseGrid(1, 1, 1, 1.0f)), e});
     d.storage = VdbMediumDesc::Storage::Dense;  // the dense limit (auto keeps this sparse)
-    CHECK_THAT(load_error(d), Catch::Contains("2001 x 2001 x 1001") && Catch::Contains("2^30"));
+    CHECK_THAT(volume_load_error(d), Catch::Contains("2001 x 2001 x 1001") && Catch::Contains("2^30"));
   }
   SECTION("dense grids above the memory left by --max-memory") {
     const DenseGrid one(1, 1, 1, 0.5f), eta_one(1, 1, 1, 1.5f);
@@ -260,11 +261,11 @@ TEST_CASE("bad volumes: transforms, backgrounds, non-finite values, sizes", "[vd
     d.albedo_grid = "albedo";
     d.max_dense_bytes = 16ull << 20;
     d.storage = VdbMediumDesc::Storage::Dense;  // the dense limit (auto keeps this sparse)
-    CHECK_THAT(load_error(d), Catch::Contains("128 x 128 x 128") && Catch::Contains("24 MiB") &&
+    CHECK_THAT(volume_load_error(d), Catch::Contains("128 x 128 x 128") && Catch::Contains("24 MiB") &&
                                   Catch::Contains("--max-memory"));
   }
   SECTION("unreadable path: a folder") {
-    CHECK_THAT(load_error(desc_for(fs::path(d.file).parent_path().string())),
+    CHECK_THAT(volume_load_error(desc_for(fs::path(d.file).parent_path().string())),
                Catch::Contains("directory"));
   }
 }
@@ -378,30 +379,30 @@ TEST_CASE("generated cloud and tissue have the documented structure", "[vdb]") {
 #endif
 
 namespace {
-struct Run {
+struct VolumeRun {
   int code = -1;
   std::string out, err;
 };
 
-std::string slurp(const fs::path& p) {
+std::string slurp_volume_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 // Runs the femto binary with `args` (no shell quoting needed: the tests use plain paths).
-Run femto_cli(const std::string& args) {
+VolumeRun femto_cli(const std::string& args) {
   const fs::path out = vol_path("cli_stdout.txt"), err = vol_path("cli_stderr.txt");
   const std::string cmd = std::string("'") + FEMTO_BINARY + "' " + args + " >'" + out.string() +
                           "' 2>'" + err.string() + "' </dev/null";
   const int status = std::system(cmd.c_str());
-  Run r;
+  VolumeRun r;
   if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
-  r.out = slurp(out);
-  r.err = slurp(err);
+  r.out = slurp_volume_file(out);
+  r.err = slurp_volume_file(err);
   return r;
 }
 
-std::string scene_with(const std::string& medium) {
+std::string volume_scene_with(const std::string& medium) {
   return R"({"camera": {"position": [0, 0, 50], "look_at": [0, 0, 0], "resolution": [8, 8]},
     "time": {"bin_width": 10, "bins": 4},
     "media": {"vol": )" + medium + R"(},
@@ -409,7 +410,7 @@ std::string scene_with(const std::string& medium) {
     "lights": [{"type": "point", "position": [0, 20, 0], "intensity": 1}]})";
 }
 
-void write_text(const std::string& path, const std::string& text) {
+void write_volume_text(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 }  // namespace
@@ -417,7 +418,7 @@ void write_text(const std::string& path, const std::string& text) {
 // Catches: make-volume output that differs from the generator, or info that misreports a volume.
 TEST_CASE("femto make-volume and femto info", "[vdb]") {
   const std::string cloud = vol_path("cli_cloud.vdb"), tissue = vol_path("cli_tissue.vdb");
-  Run r = femto_cli("make-volume cloud --out " + cloud + " --resolution 16 --seed 5 --quiet");
+  VolumeRun r = femto_cli("make-volume cloud --out " + cloud + " --resolution 16 --seed 5 --quiet");
   REQUIRE(r.code == 0);
   CHECK(r.err.empty());
   CHECK(r.out.empty());
@@ -440,7 +441,7 @@ TEST_CASE("femto make-volume and femto info", "[vdb]") {
   REQUIRE(r.code == 0);
   CHECK_THAT(r.err, Catch::Contains("12^3 voxels of 1 mm"));
   const std::string scene = vol_path("cli_scene.json");
-  write_text(scene, scene_with(R"({"type": "vdb", "file": "cli_tissue.vdb", "sigma_t_scale": 2,
+  write_volume_text(scene, volume_scene_with(R"({"type": "vdb", "file": "cli_tissue.vdb", "sigma_t_scale": 2,
       "albedo_grid": "albedo", "eta_grid": "eta", "eta": 1.37, "g": 0.8})"));
   r = femto_cli("info " + scene);
   REQUIRE(r.code == 0);
@@ -456,7 +457,7 @@ TEST_CASE("femto make-volume and femto info", "[vdb]") {
   DenseGrid bad(2, 2, 2, 1.0f);
   bad.at(1, 0, 1) = -3.0f;
   write_volume(vol_path("cli_bad.vdb"), bad, nullptr, nullptr, 1.0, {0, 0, 0});
-  write_text(scene, scene_with(R"({"type": "vdb", "file": "cli_bad.vdb", "sigma_t_scale": 1})"));
+  write_volume_text(scene, volume_scene_with(R"({"type": "vdb", "file": "cli_bad.vdb", "sigma_t_scale": 1})"));
   r = femto_cli("info " + scene);
   CHECK(r.code == 2);
   CHECK(r.out.empty());
@@ -467,7 +468,7 @@ TEST_CASE("femto make-volume and femto info", "[vdb]") {
 
 // Catches: flags that are silently ignored or errors that exit with the wrong code.
 TEST_CASE("femto make-volume and femto info: help and bad input", "[vdb]") {
-  Run r = femto_cli("make-volume --help");
+  VolumeRun r = femto_cli("make-volume --help");
   CHECK(r.code == 0);
   CHECK_THAT(r.out, Catch::Contains("cloud") && Catch::Contains("tissue") &&
                         Catch::Contains("--resolution") && Catch::Contains("--voxel") &&

@@ -9,7 +9,6 @@
 namespace femto::diffusion {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 Quadrature make_gauss_legendre(int n) {
   Quadrature q;

@@ -189,7 +189,6 @@ void PhotonTally::add(const Segment& s, TallySums& into) {
 // leave a shell there and come back).
 template <bool kWeighted>
 void PhotonTally::sweep(const Segment& s, double tau_lo, double tau_hi, int j, TallySums& into) {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   const TimeAxis& ax = grid_.time;
   const int n = grid_.shells, last = ax.bins - 1;
   const double dr = grid_.dr, v2 = s.v * s.v, inv_v = 1.0 / s.v;

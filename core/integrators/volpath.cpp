@@ -13,7 +13,6 @@
 namespace femto {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& filter,

@@ -18,7 +18,7 @@ constexpr size_t kDataOffset = 352;  // header + 4-byte extension flag
 // Header field offsets (NIfTI-1 standard).
 constexpr size_t kDim = 40, kDatatype = 70, kBitpix = 72, kPixdim = 76, kVoxOffset = 108,
                  kSclSlope = 112, kSclInter = 116, kXyztUnits = 123, kDescrip = 148,
-                 kQformCode = 252, kSformCode = 254, kSrowX = 280, kMagic = 344;
+                 kQformCode = 252, kSformCode = 254, kSrowX = 280, kMagicAt = 344;
 
 template <class T>
 T get(const std::vector<char>& b, size_t at, bool swap) {
@@ -102,7 +102,7 @@ NiftiVolume read_nifti(const std::string& path) {
       throw InputError(path + ": not a NIfTI-1 file (sizeof_hdr is not 348)");
     swap = true;
   }
-  if (std::memcmp(hdr.data() + kMagic, "n+1\0", 4) != 0)
+  if (std::memcmp(hdr.data() + kMagicAt, "n+1\0", 4) != 0)
     throw InputError(path +
                      ": not a single-file NIfTI-1 volume (magic is not \"n+1\"; .hdr/.img pairs "
                      "and NIfTI-2 are not supported)");
@@ -183,7 +183,7 @@ void write_nifti_float32(const std::string& path, const std::array<int, 4>& dim,
     put<float>(hdr, kSrowX + 16 * r + 4 * r, static_cast<float>(pixdim[r]));
     put<float>(hdr, kSrowX + 16 * r + 12, static_cast<float>(origin[r] + 0.5 * pixdim[r]));
   }
-  std::memcpy(hdr.data() + kMagic, "n+1\0", 4);
+  std::memcpy(hdr.data() + kMagicAt, "n+1\0", 4);
   write_atomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::binary);
     out.write(hdr.data(), static_cast<std::streamsize>(hdr.size()));

@@ -96,8 +96,8 @@ struct Rect {
 };
 
 // Liang–Barsky: clips the segment (a, b) to the box; false when nothing is left.
-bool clip(double& ax, double& ay, double& bx, double& by, double x0, double y0, double x1,
-          double y1) {
+bool clip_segment(double& ax, double& ay, double& bx, double& by, double x0, double y0, double x1,
+                  double y1) {
   double t0 = 0, t1 = 1;
   const double dx = bx - ax, dy = by - ay;
   const double p[4] = {-dx, dx, -dy, dy}, q[4] = {ax - x0, x1 - ax, ay - y0, y1 - ay};
@@ -123,7 +123,7 @@ bool clip(double& ax, double& ay, double& bx, double& by, double x0, double y0, 
 void draw_segment(Canvas& c, const Rect& box, double ax, double ay, double bx, double by, int width,
                   Rgb8 col, int dash, double& run) {
   const double len = std::hypot(bx - ax, by - ay);
-  if (!clip(ax, ay, bx, by, box.x0, box.y0, box.x1 - 1, box.y1 - 1)) {
+  if (!clip_segment(ax, ay, bx, by, box.x0, box.y0, box.x1 - 1, box.y1 - 1)) {
     run += len;
     return;
   }

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/constants.h"
 #include "core/scene_desc.h"
 
 namespace femto::scene_json {
@@ -17,7 +18,6 @@ namespace femto::scene_json {
 using Json = nlohmann::ordered_json;
 using Keys = std::vector<std::string>;
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr std::uint64_t kMaxFilmBytes = 64ull << 30;  // guards against typos like 1e6 bins
 // Bounds of docs/scene-format.md ("Bounds"): values become floats (Embree, the film) or ints.
 constexpr double kMaxMagnitude = 1e9;   // any number, in its unit

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "core/constants.h"
 #include "core/error.h"
 #include "core/io/nifti.h"
 #include "media/label_grid_vdb.h"
@@ -17,7 +18,6 @@ namespace femto::tissue {
 namespace {
 using Json = nlohmann::json;
 using Keys = std::vector<std::string>;
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMaxCells = 268435456.0;  // 2^28 label voxels (512 MiB of labels)
 constexpr double kMaxTallyCells =
     68719476736.0;  // 2^36 fluence cells x gates: bounds every size computation

@@ -58,7 +58,6 @@ struct VoxelDda {
   double t_max[3] = {0, 0, 0}, t_delta[3] = {0, 0, 0};
 
   VoxelDda(const Vec3& x, const Vec3& d, const int c[3], const Vec3& origin, const Vec3& h) {
-    constexpr double kInf = std::numeric_limits<double>::infinity();
     for (int a = 0; a < 3; ++a) {
       cell[a] = c[a];
       if (d[a] == 0) {
@@ -268,7 +267,6 @@ inline double one_minus_exp(double x) {
 /// energy, time, label and voxel) and returns what ended it.
 template <class Space>
 StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& rng, Segment& seg) {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   const auto& o = space.optics_at(p);  // a reference, or a voxel's optics by value
   const bool analog = ws.absorption == Absorption::Analog;
   const double rate = analog ? o.mu_t : o.mu_s;

@@ -9,7 +9,6 @@
 namespace femto {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 }
 
 PathStats& PathStats::operator+=(const PathStats& o) {
