@@ -87,14 +87,14 @@ Uniformity uniformity_of(const std::vector<double>& t, double a, double b) {
           st::ks_p_value(st::ks_statistic_uniform(t, a, b), t.size())};
 }
 
-struct Geometry {
+struct RayGeometry {
   const char* name;
   Vec3 o, w, p;
 };
 
 // Sensor ray from the origin along +z; target positions relative to it.
 const Vec3 kO(0, 0, 0), kW(0, 0, 1);
-const Geometry kRayGeometries[] = {
+const RayGeometry kRayGeometries[] = {
     {"target beside the middle", kO, kW, Vec3(3, 0, 5)},
     {"target ahead, off the ray", kO, kW, Vec3(1, 2, 30)},
     {"target behind the ray start", kO, kW, Vec3(-2, 1, -6)},
@@ -114,7 +114,7 @@ const Geometry kRayGeometries[] = {
 TEST_CASE("equiangular: samples follow the pdf, pdf normalised, CDF round trip",
           "[samplers][time][equiangular]") {
   uint64_t seed = 100;
-  for (const Geometry& g : kRayGeometries) {
+  for (const RayGeometry& g : kRayGeometries) {
     const double s_a = 0.5, s_b = 12.0;
     const femto::EquiangularSampler eq(g.o, g.w, g.p, s_a, s_b);
     INFO(g.name << "  Delta = " << eq.delta() << "  h = " << eq.h());
@@ -148,7 +148,7 @@ TEST_CASE("equiangular: no sample when the target lies on the segment",
 
 namespace {
 struct LtpCase {
-  Geometry g;
+  RayGeometry g;
   double eta, t_a, t_b, s_min, s_max;
 };
 const LtpCase kLtpCases[] = {
