@@ -12,9 +12,6 @@
 
 namespace femto {
 
-namespace {
-}  // namespace
-
 VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& filter,
                                      int max_depth, const RouletteDesc& roulette)
     : scene_(scene),
