@@ -138,7 +138,7 @@ double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& 
 
 VolPathIntegrator::LineToPointTarget VolPathIntegrator::line_to_point_target(
     const Medium& med, const ConnectedSegment& segment, const Light& L, bool narrow) const {
-  const Ray& ray = segment.ray;
+  const Ray& ray = segment.ray();
   const double t = segment.t, t_factor = segment.t_factor;
   LineToPointTarget target{
       false, 0.0, LineToPointSampler(ray.o, ray.d, L.position, med.eta_at(ray.o)), {}};
@@ -168,7 +168,7 @@ double VolPathIntegrator::collision_density(const Medium& med, int m, const Ray&
 void VolPathIntegrator::estimate_segment(const Medium& med, int m, const ConnectedSegment& segment,
                                          const RGB& beta, Rng& rng, PixelAccumulator& acc,
                                          PathStats& stats) const {
-  const Ray& ray = segment.ray;
+  const Ray& ray = segment.ray();
   const double t = segment.t, t_factor = segment.t_factor;
   const LightSet& lights = scene_.lights();
   double pmf = 0;

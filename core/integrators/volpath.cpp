@@ -46,28 +46,28 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
 
 bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
   if (!active) return false;
-  return all || decided || auto_connects(light, ray.o, ray.d, s_surf, sigma_t);
+  return all || decided || auto_connects(light, ray_ptr->o, ray_ptr->d, s_surf, sigma_t);
 }
 
 bool VolPathIntegrator::ConnectedSegment::mis_with_collisions(const Light& light) const {
-  return time_mis && lights_from_start(ray.o, ray.d, light.position);
+  return time_mis && lights_from_start(ray_ptr->o, ray_ptr->d, light.position);
 }
 
-VolPathIntegrator::ConnectedSegment VolPathIntegrator::plan_segment(const Medium& med,
-                                                                    const Ray& ray, double s_surf,
-                                                                    double t, double t_factor,
-                                                                    bool camera_segment) const {
-  ConnectedSegment segment;
+void VolPathIntegrator::plan_segment(const Medium& med, const Ray& ray, double s_surf, double t,
+                                     double t_factor, bool camera_segment,
+                                     ConnectedSegment& segment) const {
+  segment.active = segment.all = segment.decided = segment.time_mis = false;
+  segment.lp_target.reset();
   if (med.connection == ConnectionSampling::Collision || point_lights_.empty() || !med.interacts())
-    return segment;
-  segment.ray = ray;
+    return;
+  segment.ray_ptr = &ray;  // the loop's ray, unchanged while the plan is used
   segment.s_surf = s_surf;
   segment.t = t;
   segment.t_factor = t_factor;
   segment.all = med.connection != ConnectionSampling::Auto;
   if (segment.all) {
     segment.active = true;
-    return segment;
+    return;
   }
   segment.sigma_t = spread_sigma_t(med, ray.o);
   segment.time_mis = camera_segment && med.strategy.kind == DistanceSampling::Mfp &&
@@ -84,7 +84,6 @@ VolPathIntegrator::ConnectedSegment VolPathIntegrator::plan_segment(const Medium
     if (segment.mis_with_collisions(L))
       segment.lp_target = line_to_point_target(med, segment, L, true);
   }
-  return segment;
 }
 
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
@@ -109,7 +108,7 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
       const double p_lp =
           target.valid && s_seg < target.s_end ? target.lp.pdf(target.win, s_seg) : 0.0;
       if (p_lp > 0) {
-        const double p_c = collision_density(med, m, segment.ray, s_seg);
+        const double p_c = collision_density(med, m, segment.ray(), s_seg);
         w_seg = p_c / (p_c + p_lp);
       }
     }
@@ -201,6 +200,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   // and ends at a collision. And light -> X* D S+ -> x_c: the first diffuse surface reached from
   // x_c through specular surfaces ends the path.
   bool from_xd = false, from_xd_specular = false;
+  ConnectedSegment segment;  // the current segment's connection plan (plan_segment)
 
   for (;;) {
     SurfaceHit hit;
@@ -229,8 +229,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
                               : 0.0;
       const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next, q_tu);
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
-      const ConnectedSegment segment =
-          plan_segment(med, ray, s_surf, t, t_dropped, on_camera_segment);
+      plan_segment(med, ray, s_surf, t, t_dropped, on_camera_segment, segment);
       if ((segment.active || segment.time_mis) && medium_light)
         estimate_segment(med, m, segment, beta, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every
