@@ -121,6 +121,13 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
             {"schedule",
              "R_{j+1} = R_j ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j "
              "+ 1))^beta_t"}};
+      if (p.hybrid_beams)
+        j["light_tracing"] = {
+            {"description",
+             "light paths splatted to the sensor for the light that camera paths leave to them "
+             "(docs/ARCHITECTURE.md, \"Path-space partition\")"},
+            {"light_paths_per_pass", p.hybrid_light_paths},
+            {"set_by", opt.light_paths > 0 ? "light_paths" : "default: one per four pixels"}};
       j[beams ? "beam_memory_bytes_peak" : "photon_memory_bytes_peak"] = p.peak_photon_bytes;
       break;
     }
@@ -155,7 +162,9 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
             {"max_depth", opt.max_depth},
             {"russian_roulette", roulette_json(kind, opt.roulette)},
             {"integrator", integrator_name(kind)},
-            {"light_paths", kind == IntegratorKind::Light ? opt.light_paths : 0},
+            {"light_paths", kind == IntegratorKind::Light || kind == IntegratorKind::Hybrid
+                                ? opt.light_paths
+                                : 0},
             {"photons", kind != IntegratorKind::Photons && kind != IntegratorKind::Beams &&
                                 kind != IntegratorKind::Hybrid
                             ? nlohmann::json(nullptr)

@@ -36,6 +36,9 @@ struct Options {
   /// Renders per estimator (seeds seed, seed + 1, ...; default-scene mode): errors are the RMS
   /// over them, seconds their mean. Heavy-tailed estimators need several for a steady figure.
   int seeds = 1;
+  /// The hybrid's light-traced share, in light paths per pixel per pass: one hybrid line per
+  /// value (default-scene mode; 0 = its default, one per four pixels).
+  std::vector<double> hybrid_light_paths = {0.0};
 };
 
 double now_s() {
@@ -178,12 +181,16 @@ Errors errors(const V* steady, const V* transient, const Reference& ref, const s
   return {std::sqrt(se_s / n) / (m_s / n), std::sqrt(se_t / (n * T)) / (m_t / (n * T))};
 }
 
+/// `per_pixel`: the hybrid's light paths per pixel per pass (0: its default).
 RenderResult run(const Scene& scene, IntegratorKind kind, int64_t work, const Options& o,
-                 uint64_t seed) {
+                 uint64_t seed, double per_pixel = 0) {
   RenderOptions opt;
   opt.integrator = kind;
   opt.spp = kind == IntegratorKind::Light ? 1 : static_cast<int>(std::max<int64_t>(1, work));
   opt.light_paths = kind == IntegratorKind::Light ? work : 0;
+  if (kind == IntegratorKind::Hybrid && per_pixel > 0)
+    opt.light_paths = std::max<int64_t>(
+        1, std::llround(per_pixel * scene.camera().width() * scene.camera().height() * opt.spp));
   opt.photons = scene.desc().integrator.photons;
   opt.threads = o.threads;
   opt.seed = seed;
@@ -192,14 +199,15 @@ RenderResult run(const Scene& scene, IntegratorKind kind, int64_t work, const Op
 }
 
 /// Work (spp, passes or light paths) that takes about o.seconds, from a short calibration run.
-int64_t work_for_budget(const Scene& scene, IntegratorKind kind, const Options& o) {
+int64_t work_for_budget(const Scene& scene, IntegratorKind kind, const Options& o,
+                        double per_pixel = 0) {
   const int64_t pixels = static_cast<int64_t>(scene.camera().width()) * scene.camera().height();
   // One pass of all beams is slow in this large, thin fog: probe with one.
   const int64_t probe = kind == IntegratorKind::Light   ? 4 * pixels
                         : kind == IntegratorKind::Beams ? 1
                                                         : 4;
   const double t0 = now_s();
-  run(scene, kind, probe, o, 999);
+  run(scene, kind, probe, o, 999, per_pixel);
   const double dt = now_s() - t0;
   return std::max<int64_t>(1, static_cast<int64_t>(static_cast<double>(probe) * o.seconds / dt));
 }
@@ -386,6 +394,26 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "femto-bench-caustics: --seeds must be 1 to 99\n");
         return 2;
       }
+    } else if (a == "--hybrid-light-paths") {
+      // X,Y,...: light paths per pixel per pass, one hybrid line each (0: the default)
+      o.hybrid_light_paths.clear();
+      const std::string v = next();
+      size_t at = 0;
+      while (at <= v.size()) {
+        const size_t comma = std::min(v.find(',', at), v.size());
+        char* end = nullptr;
+        const std::string item = v.substr(at, comma - at);
+        const double x = std::strtod(item.c_str(), &end);
+        if (item.empty() || *end != '\0' || !(x >= 0) || x > 1000) {
+          std::fprintf(stderr,
+                       "femto-bench-caustics: --hybrid-light-paths expects numbers 0 to 1000 "
+                       "separated by commas (got '%s')\n",
+                       v.c_str());
+          return 2;
+        }
+        o.hybrid_light_paths.push_back(x);
+        at = comma + 1;
+      }
     } else if (a == "--scene")
       scene_file = next();
     else if (a == "--through-glass")
@@ -405,11 +433,14 @@ int main(int argc, char** argv) {
     } else if (a == "--help") {
       std::printf(
           "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S] "
-          "[--crop X0,Y0,X1,Y1] [--through-glass] [--seeds K]\n  default crop: the caustic on the "
+          "[--crop X0,Y0,X1,Y1] [--through-glass] [--seeds K] [--hybrid-light-paths X,...]\n"
+          "  default crop: the caustic on the "
           "floor; "
           "--crop 100,88,156,128: the fog under the sphere; --through-glass: the spot aimed at "
           "the sphere, its cone inside the sphere's silhouette (all of its light enters the "
-          "glass); --seeds K: K renders per estimator, errors as their RMS (1 to 99)\n"
+          "glass); --seeds K: K renders per estimator, errors as their RMS (1 to 99); "
+          "--hybrid-light-paths X,...: one hybrid line per value of its light-traced share, in "
+          "light paths per pixel per pass (0: the default, 0.25)\n"
           "       femto-bench-caustics --scene FILE [--ref-passes N] [--size W,H] [--seconds S] "
           "[--threads N]\n"
           "  a scene whose light camera paths cannot reach (data/scenes/tissue_laser.json): "
@@ -477,18 +508,26 @@ int main(int argc, char** argv) {
   std::printf("references took %.0f s\n", now_s() - t0);
 
   struct Case {
-    const char* name;
+    std::string name;
     const Scene* scene;
     IntegratorKind kind;
     const Reference* ref;
+    double per_pixel = 0;  ///< hybrid: light paths per pixel per pass (0: default)
   };
-  const Case cases[] = {
+  std::vector<Case> cases = {
       {"path (housed sphere emitter)", &housed, IntegratorKind::Path, &ref_housed},
       {"path (open sphere emitter)", &sphere, IntegratorKind::Path, &ref_sphere},
       {"light tracing", &spot, IntegratorKind::Light, &ref_spot},
-      {"path + photons", &spot, IntegratorKind::Photons, &ref_spot},
-      {"hybrid", &spot, IntegratorKind::Hybrid, &ref_spot},
-      {"beams", &spot, IntegratorKind::Beams, &ref_spot}};
+      {"path + photons", &spot, IntegratorKind::Photons, &ref_spot}};
+  for (double x : o.hybrid_light_paths) {
+    char name[64];
+    if (x > 0)
+      std::snprintf(name, sizeof(name), "hybrid, %g light paths/px", x);
+    else
+      std::snprintf(name, sizeof(name), "hybrid");
+    cases.push_back({name, &spot, IntegratorKind::Hybrid, &ref_spot, x});
+  }
+  cases.push_back({"beams", &spot, IntegratorKind::Beams, &ref_spot});
   std::printf("\n%-32s %14s %9s %13s %16s %22s\n", "estimator", "work", "seconds", "steady rRMSE",
               "transient rRMSE", "equal-time transient");
   double base_steady = 0, base_transient = 0, base_steady_c = 0, base_transient_c = 0;
@@ -498,13 +537,14 @@ int main(int argc, char** argv) {
     return std::sqrt(std::max(0.0, e * e - own * own));
   };
   for (const Case& c : cases) {
-    const int64_t work = work_for_budget(*c.scene, c.kind, o);
+    const int64_t work = work_for_budget(*c.scene, c.kind, o, c.per_pixel);
     // K renders: squared errors and seconds averaged (errors with the reference's own variance
     // taken out, per render, for the corrected figures).
     double sq_steady = 0, sq_transient = 0, sq_steady_c = 0, sq_transient_c = 0, secs = 0;
     for (int k = 0; k < o.seeds; ++k) {
       t0 = now_s();
-      const RenderResult r = run(*c.scene, c.kind, work, o, o.seed + static_cast<uint64_t>(k));
+      const RenderResult r =
+          run(*c.scene, c.kind, work, o, o.seed + static_cast<uint64_t>(k), c.per_pixel);
       secs += now_s() - t0;
       const Errors ek = errors(r.film.steady(), r.film.transient(), *c.ref, px);
       sq_steady += ek.steady * ek.steady;
@@ -521,7 +561,7 @@ int main(int argc, char** argv) {
     const double steady_eq = e.steady * scale, transient_eq = e.transient * scale;
     // The ratios are against the housed emitter (the first line): the spot's own cone of light.
     if (&c == &cases[0]) base_steady = steady_eq, base_transient = transient_eq;
-    std::printf("%-32s %14lld %9.1f %13.4f %16.4f %12.4f (%5.1fx)\n", c.name,
+    std::printf("%-32s %14lld %9.1f %13.4f %16.4f %12.4f (%5.1fx)\n", c.name.c_str(),
                 static_cast<long long>(work), secs, e.steady, e.transient, transient_eq,
                 base_transient / transient_eq);
     std::printf("%-32s %14s %9s %13s %16s steady %.4f (%5.1fx)\n", "", "", "", "", "", steady_eq,

@@ -242,7 +242,7 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
   // The hybrid's light-traced share: at most about 8 splats per light path (light tracing's).
   if (opt.integrator == IntegratorKind::Hybrid)
     m.integrator +=
-        static_cast<uint64_t>(default_hybrid_light_paths_per_pass(static_cast<int64_t>(pixels))) *
+        static_cast<uint64_t>(hybrid_light_paths_per_pass(opt, static_cast<int64_t>(pixels))) *
             8 * (sizeof(Splat) + sizeof(const Splat*)) +
         (pixels + 1) * 8;
   if (opt.integrator == IntegratorKind::Light) m.integrator = light_batch_bytes(pixels);

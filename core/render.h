@@ -20,7 +20,9 @@ struct RenderState;
 
 struct RenderOptions {
   IntegratorKind integrator = IntegratorKind::Path;  ///< resolved (never Auto here)
-  int64_t light_paths = 0;  ///< light tracing: paths in all; 0 = spp x pixels
+  /// Light tracing: paths in all; 0 = spp x pixels. Hybrid: its light-traced share in all (spread
+  /// over the passes); 0 = hybrid_light_paths_per_pass's default.
+  int64_t light_paths = 0;
   PhotonDesc photons;       ///< photon mapping: per-pass photons, initial radius/bandwidth, schedule
   int spp = 16;
   uint64_t seed = 1;
@@ -89,6 +91,7 @@ struct RenderResult {
     double beam_radius_first = 0, beam_radius_last = 0, beam_bandwidth_first_ps = 0, beam_bandwidth_last_ps = 0;
     double beam_alpha = 0, beam_beta_t = 0;
     int64_t beam_paths = 0;
+    int64_t hybrid_light_paths = 0;  ///< hybrid: light paths per pass for light tracing's share
     double radius_first = 0, radius_last = 0, bandwidth_first_ps = 0, bandwidth_last_ps = 0;
     uint64_t max_stored_per_pass = 0;
     uint64_t peak_photon_bytes = 0;  ///< largest photon list + grid of one pass
@@ -144,6 +147,11 @@ int64_t default_hybrid_photons_per_pass(int64_t pixels);
 /// The hybrid's light paths per pass for light tracing's share (docs/ARCHITECTURE.md, "Path-space
 /// partition"): one per four pixels of the film.
 int64_t default_hybrid_light_paths_per_pass(int64_t pixels);
+
+/// The hybrid's light paths per pass: options.light_paths (paths in all, the scene's
+/// `light_paths` or --light-paths) spread evenly over its spp passes, at least one a pass; when
+/// unset, default_hybrid_light_paths_per_pass.
+int64_t hybrid_light_paths_per_pass(const RenderOptions& opt, int64_t pixels);
 
 /// Width of one pixel at the camera's look-at distance (perspective) or of the film (orthographic).
 double pixel_footprint_mm(const CameraDesc& cam);

@@ -64,7 +64,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   // diffuse surface or in a medium), which camera paths then leave out: one light path per four
   // pixels per pass (docs/ARCHITECTURE.md, "Path-space partition").
   const bool light_indirect = caustic_beams;
-  const int64_t indirect_paths = default_hybrid_light_paths_per_pass(static_cast<int64_t>(W) * H);
+  const int64_t indirect_paths = hybrid_light_paths_per_pass(opt, static_cast<int64_t>(W) * H);
   // Photon times include the emission offset: the window end plus the widest pulse spread.
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
 
@@ -228,6 +228,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
     rep.beam_alpha = bd.alpha;
     rep.beam_beta_t = bd.beta_t;
     rep.beam_paths = bd.per_pass;
+    rep.hybrid_light_paths = indirect_paths;
   }
   rep.bandwidth_last_ps = state.photon_bandwidth_last_ps;
   rep.max_stored_per_pass = state.photon_max_stored;

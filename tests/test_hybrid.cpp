@@ -4,13 +4,17 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "agreement.h"
 #include "core/integrators/photon_beams.h"
 #include "core/scene_loader.h"
+#include "run_femto.h"
 #include "scene_builders.h"
+#include "temp_dir.h"
 
 using namespace femto;
 using namespace femto::test;
@@ -274,4 +278,57 @@ TEST_CASE("hybrid: caustic beams default to a pixel's footprint, fewer paths and
   d.camera.position = {0, 0, 10000};
   CHECK(progressive_settings(Scene(d), IntegratorKind::Hybrid, PhotonDesc{}).radius ==
         Approx(0.01 * diag));
+}
+
+// Catches: the hybrid's light-traced share ignoring `light_paths` (the scene key or
+// --light-paths), spreading it over the passes wrongly, or render.json not saying what was used.
+TEST_CASE("hybrid: light_paths sets its light-traced share per pass",
+          "[hybrid][cli]") {
+  RenderOptions opt;
+  opt.spp = 4;
+  CHECK(hybrid_light_paths_per_pass(opt, 256 * 192) == 12288);  // unset: one per four pixels
+  opt.light_paths = 1000;
+  CHECK(hybrid_light_paths_per_pass(opt, 256 * 192) == 250);
+  opt.light_paths = 1002;  // 250.5 a pass: the nearest, halves up
+  CHECK(hybrid_light_paths_per_pass(opt, 256 * 192) == 251);
+  opt.light_paths = 1;  // at least one a pass
+  CHECK(hybrid_light_paths_per_pass(opt, 256 * 192) == 1);
+
+  // Glass in fog, no diffuse surface: a pass traces its caustic beam paths (--photons) and its
+  // light-traced share, and nothing else, so the light paths counted give the share per pass.
+  TempDir tmp("femto_test_hybrid_share");
+  const std::string scene = R"({
+    "camera": { "position": [0, 0, 120], "look_at": [0, 0, 0], "fov": 30, "resolution": [20, 12] },
+    "time": { "t_start": 300, "bin_width": 50, "bins": 8 },
+    "media": { "fog": { "type": "homogeneous", "sigma_a": 0.002, "sigma_s": 0.02 } },
+    "medium": "fog",
+    "shapes": [ { "type": "sphere", "center": [0, 0, 0], "radius": 10,
+                  "material": { "type": "dielectric", "eta": 1.5 } } ],
+    "lights": [ { "type": "point", "position": [0, 40, 0], "intensity": 100 } ],
+    "render": { "light_paths": 3001 }
+  })";
+  write_file(tmp.dir / "glass.json", scene);
+  struct Case {
+    std::vector<std::string> flags;
+    uint64_t per_pass;
+    const char* set_by;
+  };
+  const Case cases[] = {{{}, 1501, "light_paths"},  // the scene's 3001 over 2 passes
+                        {{"--light-paths", "600"}, 300, "light_paths"}};
+  for (const Case& c : cases) {
+    const std::filesystem::path out = tmp.dir / "out";
+    std::vector<std::string> args = {"render", "glass.json", "--spp", "2", "--integrator",
+                                     "hybrid", "--photons", "500", "--out", "out", "--quiet",
+                                     "--frames", "none", "--no-previews"};
+    args.insert(args.end(), c.flags.begin(), c.flags.end());
+    const Run r = run_femto(args, tmp.dir);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const nlohmann::json info = nlohmann::json::parse(read_file(out / "render.json"));
+    const nlohmann::json& share = info["settings"]["integrator"]["light_tracing"];
+    CHECK(share["light_paths_per_pass"].get<uint64_t>() == c.per_pass);
+    CHECK(share["set_by"] == c.set_by);
+    CHECK(info["counters"]["light_paths"].get<uint64_t>() == 2u * (500u + c.per_pass));
+    std::filesystem::remove_all(out);
+  }
 }

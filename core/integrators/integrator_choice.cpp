@@ -104,6 +104,12 @@ int64_t default_hybrid_light_paths_per_pass(int64_t pixels) {
   return std::max<int64_t>(1, pixels / 4);
 }
 
+int64_t hybrid_light_paths_per_pass(const RenderOptions& opt, int64_t pixels) {
+  if (opt.light_paths <= 0) return default_hybrid_light_paths_per_pass(pixels);
+  const int64_t passes = std::max(1, opt.spp);
+  return std::max<int64_t>(1, (opt.light_paths + passes / 2) / passes);  // nearest, at least 1
+}
+
 double pixel_footprint_mm(const CameraDesc& cam) {
   if (cam.type == CameraDesc::Type::Orthographic) return cam.ortho_width / cam.width;
   const double distance = length(cam.look_at - cam.position);
