@@ -68,10 +68,15 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
   if (opt.frames == OutputOptions::Frames::Files) {
     fs::create_directory(dir / "frames", ec);  // not recursive: never recreates a removed staging folder
     if (ec) throw RuntimeError((dir / "frames").string() + ": cannot create folder: " + ec.message());
-    for (int t = 0; t < T; ++t) {
-      const std::vector<float> f = film.frame(t);
-      write_exr_rgb(path_of(frame_file_name(axis, t)), W, H, f.data(), attrs);
-    }
+    // Frames are independent files: compressing them one after another took about a third of
+    // the time spent writing a default render's outputs.
+    tbb::task_arena frame_arena(opt.threads > 0 ? opt.threads : tbb::task_arena::automatic);
+    frame_arena.execute([&] {
+      tbb::parallel_for(0, T, [&](int t) {
+        const std::vector<float> f = film.frame(t);
+        write_exr_rgb(path_of(frame_file_name(axis, t)), W, H, f.data(), attrs);
+      });
+    });
     files.push_back("frames/");
   } else if (opt.frames == OutputOptions::Frames::Multipart) {
     std::vector<std::string> names;
