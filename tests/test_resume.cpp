@@ -13,6 +13,7 @@
 #include "core/checkpoint.h"
 #include "core/error.h"
 #include "core/io/sha256.h"
+#include "core/rng.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
 #include "run_femto.h"
@@ -136,6 +137,32 @@ TEST_CASE("sha256 matches the FIPS 180-4 test vectors", "[resume]") {
     left -= n;
   }
   CHECK(h.hex() == "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+// Catches: the CPU's SHA instructions (used when present) and the portable code disagreeing, e.g.
+// a wrong state layout, message schedule or byte order in either, for any length and any split
+// of the input into updates; and the portable code failing the FIPS vectors where the machine
+// running the tests takes the hardware path.
+TEST_CASE("sha256: the hardware and portable paths give the same digests", "[resume]") {
+  INFO("SHA instructions on this CPU: " << sha256_hardware_available());
+  Sha256 portable(false);
+  portable.update("abc", 3);
+  CHECK(portable.hex() == "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  Rng rng(2026, 12);
+  std::string bytes(5000, '\0');
+  for (char& c : bytes) c = static_cast<char>(rng.uniform() * 256.0);
+  for (size_t len : {0u, 1u, 55u, 56u, 63u, 64u, 65u, 127u, 128u, 1000u, 4099u, 5000u}) {
+    Sha256 a(true), b(false);
+    size_t at = 0;
+    while (at < len) {  // pieces of 1 to 200 bytes
+      const size_t n = std::min(len - at, size_t{1} + static_cast<size_t>(rng.uniform() * 200.0));
+      a.update(bytes.data() + at, n);
+      b.update(bytes.data() + at, n);
+      at += n;
+    }
+    INFO("length " << len);
+    CHECK(a.hex() == b.hex());
+  }
 }
 
 // Catches: passes that change the per-pixel summation order (different bits), state that is

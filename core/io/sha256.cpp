@@ -8,6 +8,12 @@
 
 #include "core/error.h"
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define FEMTO_SHA_NI 1
+#include <cpuid.h>
+#include <immintrin.h>
+#endif
+
 namespace femto {
 
 namespace {
@@ -22,7 +28,80 @@ constexpr uint32_t kRound[64] = {
     0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2};
 
 inline uint32_t rotr(uint32_t x, int n) { return (x >> n) | (x << (32 - n)); }
+
+#ifdef FEMTO_SHA_NI
+bool cpu_has_sha() {
+  unsigned a, b, c, d;
+  if (!__get_cpuid(1, &a, &b, &c, &d)) return false;
+  const bool ssse3 = (c >> 9) & 1, sse41 = (c >> 19) & 1;
+  if (!__get_cpuid_count(7, 0, &a, &b, &c, &d)) return false;
+  return ssse3 && sse41 && ((b >> 29) & 1);
+}
+
+/// n blocks with the SHA extensions. The state is kept as (A, B, E, F) and (C, D, G, H), the
+/// layout sha256rnds2 works on; each group of four rounds takes its schedule words from
+/// sha256msg1 / sha256msg2 (W_t = sigma1(W_t-2) + W_t-7 + sigma0(W_t-15) + W_t-16).
+__attribute__((target("sha,sse4.1,ssse3"))) void blocks_sha_ni(uint32_t h[8], const uint8_t* p,
+                                                                size_t n) {
+  const __m128i bswap = _mm_set_epi64x(0x0c0d0e0f08090a0bLL, 0x0405060700010203LL);
+  __m128i tmp = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h));      // D C B A
+  __m128i s1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + 4));   // H G F E
+  tmp = _mm_shuffle_epi32(tmp, 0xB1);                                      // C D A B
+  s1 = _mm_shuffle_epi32(s1, 0x1B);                                        // E F G H
+  __m128i s0 = _mm_alignr_epi8(tmp, s1, 8);                                // A B E F
+  s1 = _mm_blend_epi16(s1, tmp, 0xF0);                                     // C D G H
+  for (; n > 0; --n, p += 64) {
+    const __m128i save0 = s0, save1 = s1;
+    __m128i x[4];
+    for (int g = 0; g < 16; ++g) {
+      __m128i w;
+      if (g < 4) {
+        w = _mm_shuffle_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16 * g)), bswap);
+      } else {  // x[g & 3] still holds group g - 4
+        w = _mm_sha256msg1_epu32(x[g & 3], x[(g - 3) & 3]);
+        w = _mm_add_epi32(w, _mm_alignr_epi8(x[(g - 1) & 3], x[(g - 2) & 3], 4));
+        w = _mm_sha256msg2_epu32(w, x[(g - 1) & 3]);
+      }
+      x[g & 3] = w;
+      __m128i m =
+          _mm_add_epi32(w, _mm_loadu_si128(reinterpret_cast<const __m128i*>(kRound + 4 * g)));
+      s1 = _mm_sha256rnds2_epu32(s1, s0, m);
+      m = _mm_shuffle_epi32(m, 0x0E);
+      s0 = _mm_sha256rnds2_epu32(s0, s1, m);
+    }
+    s0 = _mm_add_epi32(s0, save0);
+    s1 = _mm_add_epi32(s1, save1);
+  }
+  tmp = _mm_shuffle_epi32(s0, 0x1B);     // F E B A
+  s1 = _mm_shuffle_epi32(s1, 0xB1);      // D C H G
+  s0 = _mm_blend_epi16(tmp, s1, 0xF0);   // D C B A
+  s1 = _mm_alignr_epi8(s1, tmp, 8);      // H G F E
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(h), s0);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(h + 4), s1);
+}
+#endif
 }  // namespace
+
+bool sha256_hardware_available() {
+#ifdef FEMTO_SHA_NI
+  static const bool has = cpu_has_sha();
+  return has;
+#else
+  return false;
+#endif
+}
+
+Sha256::Sha256(bool hardware) : hardware_(hardware && sha256_hardware_available()) { reset(); }
+
+void Sha256::blocks(const uint8_t* p, size_t n) {
+#ifdef FEMTO_SHA_NI
+  if (hardware_) {
+    blocks_sha_ni(h_, p, n);
+    return;
+  }
+#endif
+  for (; n > 0; --n, p += 64) block(p);
+}
 
 void Sha256::reset() {
   const uint32_t init[8] = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
@@ -80,10 +159,13 @@ void Sha256::update(const void* data, size_t bytes) {
     p += take;
     bytes -= take;
     if (used_ < 64) return;
-    block(buf_);
+    blocks(buf_, 1);
     used_ = 0;
   }
-  for (; bytes >= 64; p += 64, bytes -= 64) block(p);
+  const size_t n = bytes / 64;
+  blocks(p, n);
+  p += 64 * n;
+  bytes -= 64 * n;
   std::memcpy(buf_, p, bytes);
   used_ = bytes;
 }

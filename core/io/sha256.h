@@ -8,7 +8,10 @@ namespace femto {
 
 class Sha256 {
  public:
-  Sha256() { reset(); }
+  Sha256() : Sha256(true) {}
+  /// hardware: use the CPU's SHA instructions when it has them (x86-64 SHA extensions); false
+  /// forces the portable code. Both give the same digests.
+  explicit Sha256(bool hardware);
   void reset();
   void update(const void* data, size_t bytes);
   /// Finishes the hash (the object must be reset before reuse) and returns the 32-byte digest.
@@ -17,12 +20,17 @@ class Sha256 {
   std::string hex();
 
  private:
+  void blocks(const uint8_t* p, size_t n);  ///< n whole 64-byte blocks
   void block(const uint8_t* p);
+  bool hardware_;
   uint32_t h_[8];
   uint8_t buf_[64];
   size_t used_ = 0;
   uint64_t length_ = 0;  ///< bytes hashed so far
 };
+
+/// Whether this CPU has the SHA instructions the hardware path uses.
+bool sha256_hardware_available();
 
 std::string sha256_hex(const std::string& bytes);
 /// Hash of a file's bytes, streamed. Throws RuntimeError naming the file when it cannot be read.
