@@ -207,8 +207,10 @@ RenderSetup apply_render_overrides(SceneDesc& desc, const RenderOverrides& o,
         ": integrator \"beams\": the scene has no scattering medium, so there are no beams "
         "to gather; use --integrator path, light or photons");
   if (o.light_paths && kind != IntegratorKind::Light && kind != IntegratorKind::Hybrid)
-    throw InputError(command + ": --light-paths: applies to --integrator light and hybrid only, but the integrator is \"" +
-                     integrator_name(kind) + "\"");
+    throw InputError(
+        command +
+        ": --light-paths: applies to --integrator light and hybrid only, but the integrator is \"" +
+        integrator_name(kind) + "\"");
   RenderOptions opt;
   opt.integrator = kind;
   opt.light_paths = desc.integrator.light_paths;

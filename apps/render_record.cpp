@@ -162,9 +162,8 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
             {"max_depth", opt.max_depth},
             {"russian_roulette", roulette_json(kind, opt.roulette)},
             {"integrator", integrator_name(kind)},
-            {"light_paths", kind == IntegratorKind::Light || kind == IntegratorKind::Hybrid
-                                ? opt.light_paths
-                                : 0},
+            {"light_paths",
+             kind == IntegratorKind::Light || kind == IntegratorKind::Hybrid ? opt.light_paths : 0},
             {"photons", kind != IntegratorKind::Photons && kind != IntegratorKind::Beams &&
                                 kind != IntegratorKind::Hybrid
                             ? nlohmann::json(nullptr)

@@ -282,8 +282,7 @@ TEST_CASE("hybrid: caustic beams default to a pixel's footprint, fewer paths and
 
 // Catches: the hybrid's light-traced share ignoring `light_paths` (the scene key or
 // --light-paths), spreading it over the passes wrongly, or render.json not saying what was used.
-TEST_CASE("hybrid: light_paths sets its light-traced share per pass",
-          "[hybrid][cli]") {
+TEST_CASE("hybrid: light_paths sets its light-traced share per pass", "[hybrid][cli]") {
   RenderOptions opt;
   opt.spp = 4;
   CHECK(hybrid_light_paths_per_pass(opt, 256 * 192) == 12288);  // unset: one per four pixels
@@ -317,9 +316,9 @@ TEST_CASE("hybrid: light_paths sets its light-traced share per pass",
                         {{"--light-paths", "600"}, 300, "light_paths"}};
   for (const Case& c : cases) {
     const std::filesystem::path out = tmp.dir / "out";
-    std::vector<std::string> args = {"render", "glass.json", "--spp", "2", "--integrator",
-                                     "hybrid", "--photons", "500", "--out", "out", "--quiet",
-                                     "--frames", "none", "--no-previews"};
+    std::vector<std::string> args = {
+        "render", "glass.json", "--spp", "2",       "--integrator", "hybrid", "--photons",
+        "500",    "--out",      "out",   "--quiet", "--frames",     "none",   "--no-previews"};
     args.insert(args.end(), c.flags.begin(), c.flags.end());
     const Run r = run_femto(args, tmp.dir);
     INFO(r.err);

@@ -42,14 +42,14 @@ bool cpu_has_sha() {
 /// layout sha256rnds2 works on; each group of four rounds takes its schedule words from
 /// sha256msg1 / sha256msg2 (W_t = sigma1(W_t-2) + W_t-7 + sigma0(W_t-15) + W_t-16).
 __attribute__((target("sha,sse4.1,ssse3"))) void blocks_sha_ni(uint32_t h[8], const uint8_t* p,
-                                                                size_t n) {
+                                                               size_t n) {
   const __m128i bswap = _mm_set_epi64x(0x0c0d0e0f08090a0bLL, 0x0405060700010203LL);
-  __m128i tmp = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h));      // D C B A
-  __m128i s1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + 4));   // H G F E
-  tmp = _mm_shuffle_epi32(tmp, 0xB1);                                      // C D A B
-  s1 = _mm_shuffle_epi32(s1, 0x1B);                                        // E F G H
-  __m128i s0 = _mm_alignr_epi8(tmp, s1, 8);                                // A B E F
-  s1 = _mm_blend_epi16(s1, tmp, 0xF0);                                     // C D G H
+  __m128i tmp = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h));     // D C B A
+  __m128i s1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + 4));  // H G F E
+  tmp = _mm_shuffle_epi32(tmp, 0xB1);                                     // C D A B
+  s1 = _mm_shuffle_epi32(s1, 0x1B);                                       // E F G H
+  __m128i s0 = _mm_alignr_epi8(tmp, s1, 8);                               // A B E F
+  s1 = _mm_blend_epi16(s1, tmp, 0xF0);                                    // C D G H
   for (; n > 0; --n, p += 64) {
     const __m128i save0 = s0, save1 = s1;
     __m128i x[4];
@@ -72,10 +72,10 @@ __attribute__((target("sha,sse4.1,ssse3"))) void blocks_sha_ni(uint32_t h[8], co
     s0 = _mm_add_epi32(s0, save0);
     s1 = _mm_add_epi32(s1, save1);
   }
-  tmp = _mm_shuffle_epi32(s0, 0x1B);     // F E B A
-  s1 = _mm_shuffle_epi32(s1, 0xB1);      // D C H G
-  s0 = _mm_blend_epi16(tmp, s1, 0xF0);   // D C B A
-  s1 = _mm_alignr_epi8(s1, tmp, 8);      // H G F E
+  tmp = _mm_shuffle_epi32(s0, 0x1B);    // F E B A
+  s1 = _mm_shuffle_epi32(s1, 0xB1);     // D C H G
+  s0 = _mm_blend_epi16(tmp, s1, 0xF0);  // D C B A
+  s1 = _mm_alignr_epi8(s1, tmp, 8);     // H G F E
   _mm_storeu_si128(reinterpret_cast<__m128i*>(h), s0);
   _mm_storeu_si128(reinterpret_cast<__m128i*>(h + 4), s1);
 }
@@ -91,7 +91,9 @@ bool sha256_hardware_available() {
 #endif
 }
 
-Sha256::Sha256(bool hardware) : hardware_(hardware && sha256_hardware_available()) { reset(); }
+Sha256::Sha256(bool hardware) : hardware_(hardware && sha256_hardware_available()) {
+  reset();
+}
 
 void Sha256::blocks(const uint8_t* p, size_t n) {
 #ifdef FEMTO_SHA_NI
