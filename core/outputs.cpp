@@ -48,6 +48,8 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
                               " bins=" + std::to_string(T)}};
   nlohmann::json files = nlohmann::json::array();
   auto path_of = [&](const std::string& name) { return (dir / name).string(); };
+  // The render's threads write the frames and hash the files.
+  tbb::task_arena arena(opt.threads > 0 ? opt.threads : tbb::task_arena::automatic);
 
   write_exr_rgb(path_of("steady.exr"), W, H, film.steady(), attrs);
   files.push_back("steady.exr");
@@ -70,8 +72,7 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
     if (ec) throw RuntimeError((dir / "frames").string() + ": cannot create folder: " + ec.message());
     // Frames are independent files: compressing them one after another took about a third of
     // the time spent writing a default render's outputs.
-    tbb::task_arena frame_arena(opt.threads > 0 ? opt.threads : tbb::task_arena::automatic);
-    frame_arena.execute([&] {
+    arena.execute([&] {
       tbb::parallel_for(0, T, [&](int t) {
         const std::vector<float> f = film.frame(t);
         write_exr_rgb(path_of(frame_file_name(axis, t)), W, H, f.data(), attrs);
@@ -132,7 +133,6 @@ std::vector<std::string> write_outputs(const TransientFilm& film, const OutputOp
     }
   }
   std::vector<std::string> digests(names.size());
-  tbb::task_arena arena(opt.threads > 0 ? opt.threads : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(size_t{0}, names.size(),
                       [&](size_t i) { digests[i] = sha256_file(path_of(names[i])); });

@@ -96,6 +96,7 @@ Sha256::Sha256(bool hardware) : hardware_(hardware && sha256_hardware_available(
 }
 
 void Sha256::blocks(const uint8_t* p, size_t n) {
+  if (n == 0) return;  // update's tail: no state round trip through the SHA registers
 #ifdef FEMTO_SHA_NI
   if (hardware_) {
     blocks_sha_ni(h_, p, n);
