@@ -27,7 +27,7 @@ jobs="${FEMTO_JOBS:-$(nproc 2>/dev/null || echo 2)}"
 
 # The configuration of `scripts/quickstart.sh sanitize` (keep the two the same).
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DFEMTO_SANITIZE=ON -DFEMTO_FUZZ=ON -DFEMTO_UNITY=ON \
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1" -DFEMTO_SANITIZE=ON -DFEMTO_FUZZ=ON -DFEMTO_UNITY=ON \
       -DFEMTO_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "$jobs" --target femto-fuzz
 

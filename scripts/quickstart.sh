@@ -41,11 +41,12 @@ fi
 
 if [ "$mode" = sanitize ]; then
   # -O1: the instrumented suite runs a few times slower than Release; -O1 compiles faster than
-  # -O2 and keeps reports readable. Assertions stay on (no NDEBUG). FEMTO_FUZZ: the fuzz targets
+  # -O2 and keeps reports readable (with line tables only, set by CMakeLists.txt: a report's
+  # frames keep their file:line). Assertions stay on (no NDEBUG). FEMTO_FUZZ: the fuzz targets
   # are libFuzzer programs of this same build, so scripts/fuzz.sh compiles nothing more.
   build="${FEMTO_BUILD_DIR:-$root/build-asan}"
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-        -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DFEMTO_SANITIZE=ON -DFEMTO_FUZZ=ON -DFEMTO_UNITY=ON \
+        -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1" -DFEMTO_SANITIZE=ON -DFEMTO_FUZZ=ON -DFEMTO_UNITY=ON \
         -DFEMTO_BUILD_BENCH=OFF
   cmake --build "$build" -j "$jobs"
   cd "$build"

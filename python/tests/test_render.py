@@ -121,7 +121,9 @@ def test_gil_is_released_while_rendering():
     thread = threading.Thread(target=count)
     thread.start()
     before = len(ticks)
-    femto.render(small_scene(), spp=8, seed=2)
+    # About 0.2 s of rendering: ~200 ticks when the GIL is free, none while a render holds it
+    # (a render of 8 spp took 30 ms, too short for a bound under a loaded machine).
+    femto.render(small_scene(), spp=96, seed=2)
     during = len(ticks) - before
     stop.set()
     thread.join()
