@@ -1,10 +1,12 @@
 #include "apps/render_flags.h"
 
 #include <algorithm>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "core/error.h"
+#include "core/integrators/camera_ball.h"
 
 namespace femto {
 
@@ -142,6 +144,8 @@ bool parse_render_flag(cli::Args& args, const std::string& a, RenderOverrides& o
       args.fail("expected auto, path, light, photons, beams or hybrid", v);
   } else if (a == "--light-paths") {
     o.light_paths = static_cast<int64_t>(args.count_value(1, 1e12));  // 4e7 as well as 40000000
+  } else if (a == "--camera-ball") {
+    o.camera_ball = args.number_in(0.0, 1e6, false, false, "in [0, 1e6] mm");
   } else if (a == "--photons") {
     o.photons_per_pass = static_cast<int64_t>(args.count_value(1, 1e9));
     if (o.photon_flag.empty()) o.photon_flag = a;
@@ -182,6 +186,7 @@ RenderSetup apply_render_overrides(SceneDesc& desc, const RenderOverrides& o,
   if (o.no_onset_reflection) rec.onset_reflection = false;
   if (o.integrator) desc.integrator.kind = *o.integrator;
   if (o.light_paths) desc.integrator.light_paths = *o.light_paths;
+  if (o.camera_ball) desc.integrator.camera_ball_mm = *o.camera_ball;
   PhotonDesc& pd = desc.integrator.photons;
   if (o.photons_per_pass) pd.per_pass = *o.photons_per_pass;
   if (o.photon_radius) pd.radius = *o.photon_radius;
@@ -211,9 +216,27 @@ RenderSetup apply_render_overrides(SceneDesc& desc, const RenderOverrides& o,
         command +
         ": --light-paths: applies to --integrator light and hybrid only, but the integrator is \"" +
         integrator_name(kind) + "\"");
+  if (o.camera_ball && kind != IntegratorKind::Hybrid)
+    throw InputError(command +
+                     ": --camera-ball: applies to --integrator hybrid only, but the "
+                     "integrator is \"" +
+                     integrator_name(kind) + "\"");
+  if (kind == IntegratorKind::Hybrid && desc.integrator.camera_ball_mm > 0) {
+    // The ball must hold no surface: camera paths gather only the camera's medium inside it.
+    const double nearest = nearest_surface_distance(desc, desc.camera.position);
+    if (!(desc.integrator.camera_ball_mm < nearest)) {
+      std::ostringstream msg;
+      msg << (o.camera_ball ? command + ": --camera-ball " : where + ": /render/camera_ball ")
+          << desc.integrator.camera_ball_mm
+          << ": the ball around the camera would reach a surface (the nearest is " << nearest
+          << " mm from the camera); use a smaller radius, or 0 for none";
+      throw InputError(msg.str());
+    }
+  }
   RenderOptions opt;
   opt.integrator = kind;
   opt.light_paths = desc.integrator.light_paths;
+  opt.camera_ball_mm = desc.integrator.camera_ball_mm;
   opt.photons = pd;
   opt.spp = o.spp.value_or(desc.integrator.spp);
   opt.seed = o.seed.value_or(desc.integrator.seed);

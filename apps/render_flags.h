@@ -28,6 +28,7 @@ struct RenderOverrides {
   bool no_onset_reflection = false;
   std::optional<IntegratorKind> integrator;
   std::optional<int64_t> light_paths, photons_per_pass;
+  std::optional<double> camera_ball;
   std::optional<double> photon_radius, photon_bandwidth;
   std::string kernel_flag;  ///< the first kernel-only flag given, for the error message
   std::string photon_flag;  ///< the first photon-only flag given, for the error message

@@ -128,6 +128,16 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
              "(docs/ARCHITECTURE.md, \"Path-space partition\")"},
             {"light_paths_per_pass", p.hybrid_light_paths},
             {"set_by", opt.light_paths > 0 ? "light_paths" : "default: one per four pixels"}};
+      if (p.hybrid_beams && p.camera_ball_radius > 0)
+        j["light_tracing"]["camera_ball"] = {
+            {"description",
+             "medium points within radius_mm of the pinhole are gathered by the camera's own "
+             "segment from the light paths' pieces through the ball (long beams, 1-D kernel)"},
+            {"radius_mm", p.camera_ball_radius},
+            {"gather_radius_mm",
+             {{"first_pass", p.camera_ball_gather_radius_first},
+              {"after_last_pass", p.camera_ball_gather_radius_last}}},
+            {"max_beams_per_pass", p.camera_ball_beams_max}};
       j[beams ? "beam_memory_bytes_peak" : "photon_memory_bytes_peak"] = p.peak_photon_bytes;
       break;
     }
@@ -164,6 +174,7 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
             {"integrator", integrator_name(kind)},
             {"light_paths",
              kind == IntegratorKind::Light || kind == IntegratorKind::Hybrid ? opt.light_paths : 0},
+            {"camera_ball", kind == IntegratorKind::Hybrid ? opt.camera_ball_mm : -1.0},
             {"photons", kind != IntegratorKind::Photons && kind != IntegratorKind::Beams &&
                                 kind != IntegratorKind::Hybrid
                             ? nlohmann::json(nullptr)

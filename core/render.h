@@ -23,6 +23,8 @@ struct RenderOptions {
   /// Light tracing: paths in all; 0 = spp x pixels. Hybrid: its light-traced share in all (spread
   /// over the passes); 0 = hybrid_light_paths_per_pass's default.
   int64_t light_paths = 0;
+  /// Hybrid: the camera ball's radius, mm; < 0: camera_ball's default rule, 0: none.
+  double camera_ball_mm = -1;
   PhotonDesc photons;       ///< photon mapping: per-pass photons, initial radius/bandwidth, schedule
   int spp = 16;
   uint64_t seed = 1;
@@ -92,6 +94,11 @@ struct RenderResult {
     double beam_alpha = 0, beam_beta_t = 0;
     int64_t beam_paths = 0;
     int64_t hybrid_light_paths = 0;  ///< hybrid: light paths per pass for light tracing's share
+    /// Hybrid, camera in a scattering medium: the camera ball (core/integrators/camera_ball.h),
+    /// its gather radius at the first and last pass (mm), and the most beams one pass kept in it.
+    double camera_ball_radius = 0, camera_ball_gather_radius_first = 0,
+           camera_ball_gather_radius_last = 0;
+    uint64_t camera_ball_beams_max = 0;
     double radius_first = 0, radius_last = 0, bandwidth_first_ps = 0, bandwidth_last_ps = 0;
     uint64_t max_stored_per_pass = 0;
     uint64_t peak_photon_bytes = 0;  ///< largest photon list + grid of one pass

@@ -10,6 +10,7 @@
 #include <chrono>
 
 #include "core/distributed/render_gather.h"
+#include "core/integrators/camera_ball.h"
 #include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
 #include "core/integrators/ppm_schedule.h"
@@ -92,8 +93,14 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   tbb::enumerable_thread_specific<PathStats> stats;
   PhotonGrid grid;
   BeamBvh bvh;
-  const LightTracer indirect_tracer(scene, opt.max_depth, photon_t_cut,
-                                    LightTracer::Vertices::MediumIndirect);
+  LightTracer indirect_tracer(scene, opt.max_depth, photon_t_cut,
+                              LightTracer::Vertices::MediumIndirect);
+  // A camera inside a scattering medium: the medium points next to the pinhole are the camera
+  // paths', gathered from the light pieces through the ball (core/integrators/camera_ball.h).
+  const CameraBall ball = light_indirect ? camera_ball(scene, opt.camera_ball_mm) : CameraBall{};
+  indirect_tracer.set_camera_ball(ball);
+  BeamBvh ball_bvh;
+  uint64_t ball_beams_max = 0;
   std::vector<uint32_t> splat_offsets;
   std::vector<const Splat*> splat_order;
   double seconds_beams = 0, seconds_photons = 0, seconds_light_paths = 0, seconds_camera = 0;
@@ -137,15 +144,35 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
         pass_bytes += grid.memory_bytes();
         seconds_photons += since(part_start);
       }
+      BeamGather ball_gather;
       if (light_indirect) {
-        const std::vector<Splat> splats = trace_in_chunks<Splat>(
+        auto traced = trace_in_chunks_multi<Splat, Beam>(
             indirect_paths, kIndirectChunk, photon_stats,
-            [&](int64_t i, std::vector<Splat>& out, PathStats& st) {
+            [&](int64_t i, std::vector<Splat>& out, std::vector<Beam>& through_ball,
+                PathStats& st) {
               Rng rng = Rng::for_sample(opt.seed, kIndirectStream + static_cast<uint64_t>(pass),
                                         static_cast<uint64_t>(i));
-              indirect_tracer.trace(rng, out, st);
+              indirect_tracer.trace(rng, out, st, &through_ball);
             },
             opt.comm);
+        const std::vector<Splat>& splats = std::get<0>(traced);
+        if (ball.active()) {
+          // The gather radius shrinks with the caustic beams' schedule.
+          const double radius =
+              camera_ball_gather_radius(ball) * beam_schedule.radius() / bd.radius;
+          ball_beams_max = std::max<uint64_t>(ball_beams_max, std::get<1>(traced).size());
+          ball_bvh.build(std::move(std::get<1>(traced)), radius);
+          pass_bytes += ball_bvh.memory_bytes();
+          ball_gather.bvh = &ball_bvh;
+          ball_gather.scene = &scene;
+          ball_gather.tracker = &tracker;
+          ball_gather.radius = radius;
+          ball_gather.inv_paths = 1.0 / static_cast<double>(indirect_paths);
+          ball_gather.kernel = filter;  // the crossing's time is exact: no temporal kernel
+          ball_gather.carry_transmittance = true;
+          beam_gather.ball = &ball_gather;
+          beam_gather.ball_radius = ball.radius;
+        }
         // Each rank keeps the splats of its own bands of tile rows (gathered at the end).
         deposit_splats(
             splats, 1.0 / static_cast<double>(indirect_paths), filter, pixels, stride, nb,
@@ -210,6 +237,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   distributed::gather_bands(comm, state, W, H, kTile);
   grid = PhotonGrid();
   bvh = BeamBvh();
+  ball_bvh = BeamBvh();
   RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};
   RenderResult::PhotonReport& rep = result.photons;
   rep.passes = static_cast<int>(state.units_done);
@@ -229,6 +257,11 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
     rep.beam_beta_t = bd.beta_t;
     rep.beam_paths = bd.per_pass;
     rep.hybrid_light_paths = indirect_paths;
+    rep.camera_ball_radius = ball.radius;
+    rep.camera_ball_gather_radius_first = ball.active() ? camera_ball_gather_radius(ball) : 0.0;
+    rep.camera_ball_gather_radius_last =
+        ball.active() ? camera_ball_gather_radius(ball) * beam_schedule.radius() / bd.radius : 0.0;
+    rep.camera_ball_beams_max = ball_beams_max;
   }
   rep.bandwidth_last_ps = state.photon_bandwidth_last_ps;
   rep.max_stored_per_pass = state.photon_max_stored;

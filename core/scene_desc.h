@@ -191,6 +191,9 @@ struct IntegratorDesc {
   uint64_t seed = 1;
   IntegratorKind kind = IntegratorKind::Auto;
   int64_t light_paths = 0;       ///< light tracing: paths in all; 0 = spp x width x height
+  /// Hybrid: radius of the camera ball, mm (core/integrators/camera_ball.h); < 0: the default
+  /// rule, 0: none.
+  double camera_ball_mm = -1;
   PhotonDesc photons;
   RouletteDesc roulette;
 };

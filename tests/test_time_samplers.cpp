@@ -21,6 +21,7 @@
 #include "samplers/angular.h"
 #include "samplers/distance.h"
 #include "samplers/equiangular.h"
+#include "samplers/equiangular_outside_ball.h"
 #include "samplers/line_to_point.h"
 #include "samplers/stats.h"
 
@@ -147,6 +148,46 @@ TEST_CASE("equiangular: no sample when the target lies on the segment",
 // ---------------------------------------------------------------- line-to-point
 
 namespace {
+// Catches a wrong pick between the two intervals around the ball's chord (the pdf would jump at
+// the chord), a sample inside the ball, a pdf not normalised over what is left, and a chord
+// clipped wrongly at the segment's ends.
+TEST_CASE("equiangular outside a ball: samples follow the pdf and avoid the ball",
+          "[samplers][time][equiangular]") {
+  struct BallCase {
+    const char* name;
+    Vec3 p;
+    double r;
+  };
+  const BallCase cases[] = {
+      {"chord inside the segment (two intervals)", Vec3(0.3, 0, 5), 1.0},
+      {"chord at the start (one interval)", Vec3(0.2, 0, 0.8), 1.0},
+      {"chord past the end (the ball holds the end)", Vec3(0.1, 0, 11.5), 2.0},
+      {"line misses the ball (plain equiangular)", Vec3(3, 0, 5), 1.0},
+      {"target on the line (h = 0), chord inside", Vec3(0, 0, 6), 0.5},
+  };
+  uint64_t seed = 400;
+  const double s_a = 0.5, s_b = 12.0;
+  for (const BallCase& c : cases) {
+    INFO(c.name);
+    const femto::EquiangularOutsideBall eq(kO, kW, c.p, s_a, s_b, c.r);
+    REQUIRE(eq.valid());
+    const double delta = c.p.z, h = std::hypot(c.p.x, c.p.y);
+    const double half = c.r > h ? std::sqrt(c.r * c.r - h * h) : 0.0;
+    const auto pdf = [&](double s) { return eq.pdf(s); };
+    const st::Chi2Result r = chi2_1d([&](Rng& rng) { return eq.sample(rng.uniform()); }, pdf, s_a,
+                                     s_b, 50, seed++, {delta - half, delta, delta + half});
+    INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
+    CHECK(r.p_value >= kTimeSamplerAlpha);
+    // The density is 1 / (M (h^2 + x^2)) outside the ball and 0 inside.
+    Rng rng(seed++, 5);
+    int inside = 0;
+    for (int k = 0; k < 10000; ++k)
+      if (length(kO + kW * eq.sample(rng.uniform()) - c.p) < c.r * (1 - 1e-12)) ++inside;
+    CHECK(inside == 0);
+    CHECK(eq.pdf(delta) == (h < c.r ? 0.0 : eq.pdf(delta)));
+  }
+}
+
 struct LtpCase {
   RayGeometry g;
   double eta, t_a, t_b, s_min, s_max;

@@ -5,7 +5,7 @@
 #include "core/constants.h"
 
 #include "media/phase_hg.h"
-#include "samplers/equiangular.h"
+#include "samplers/equiangular_outside_ball.h"
 
 namespace femto {
 
@@ -36,7 +36,8 @@ void LightTracer::splat(const Vec3& x, int m, const Vec3& w, double dist, const 
   out.push_back({py * static_cast<uint32_t>(cam.width()) + px, t, sigma_ps, v});
 }
 
-void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) const {
+void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
+                        std::vector<Beam>* ball_beams) const {
   const Camera& cam = scene_.camera();
   const double eps = scene_.ray_epsilon();
   const bool indirect_only = vertices_ == Vertices::MediumIndirect;
@@ -48,7 +49,9 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
   // The current medium ray piece's equiangular sensor connection (sensor_rays_).
   bool ray_active = false;
   Ray ray_piece;
-  EquiangularSampler eq(Vec3(), Vec3(0, 0, 1), Vec3(), 0.0, 0.0);
+  const bool ball = ball_.active() && indirect_only && sensor_rays_;
+  const double r_ball = ball ? ball_.radius : 0.0;
+  EquiangularOutsideBall eq(Vec3(), Vec3(0, 0, 1), Vec3(), 0.0, 0.0, 0.0);
   const auto& media = scene_.media();
   auto visit = [&](const LightVertex& v) {
     if (v.kind == LightVertex::Kind::Ray) {
@@ -56,12 +59,15 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
       // collision density sigma_t T is the other strategy of the MIS).
       ray_active = false;
       const Medium& med = media[static_cast<size_t>(v.medium)];
-      if ((indirect_only && !scattered && !surfaced) || med.strategy.kind != DistanceSampling::Mfp)
-        return true;
+      if (indirect_only && !scattered && !surfaced) return true;
       // Up to the surface and the time cut-off (eta >= 1: time >= distance / c).
       double s0 = 0.0, s1 = std::fmin(v.length, (t_cut_ - v.t_ps) * kSpeedOfLight);
+      Beam beam;
+      if (ball && ball_beams && s1 > 0 && camera_ball_beam(tracker_, ball_, v, s1, beam))
+        ball_beams->push_back(beam);
+      if (med.strategy.kind != DistanceSampling::Mfp) return true;
       if (!(s1 > 0) || !cam.frustum_interval(v.p, v.d, s0, s1)) return true;
-      eq = EquiangularSampler(v.p, v.d, cam.position(), s0, s1);
+      eq = EquiangularOutsideBall(v.p, v.d, cam.position(), s0, s1, r_ball);
       if (!eq.valid()) return true;
       ray_active = true;
       ray_piece = {v.p, v.d};
@@ -116,6 +122,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) con
     double fx, fy, dist, W;
     Vec3 w;
     if (!cam.connect_to(v.p, fx, fy, w, dist, W)) return true;
+    // Medium points inside the camera ball are the camera paths' (through ball_beams).
+    if (ball && v.kind == LightVertex::Kind::Medium && dist < r_ball) return !v.connection_only;
     switch (v.kind) {
       case LightVertex::Kind::Emitter: {
         const double cos_e = dot(v.n, w);

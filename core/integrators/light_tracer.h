@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/integrators/camera_ball.h"
 #include "core/scene.h"
 #include "core/transport/light_walk.h"
 
@@ -30,8 +31,14 @@ class LightTracer {
   enum class Vertices { All, MediumIndirect };
   LightTracer(const Scene& scene, int max_depth, double t_cut_ps,
               Vertices vertices = Vertices::All);
-  /// Traces one light path and appends its sensor splats to `out`.
-  void trace(Rng& rng, std::vector<Splat>& out, PathStats& stats) const;
+  /// Leaves the medium points inside `ball` (MediumIndirect, perspective camera) to camera
+  /// paths: they are not splatted, and the ray pieces that pass within ball.reach go to
+  /// trace's `ball_beams` instead (core/integrators/camera_ball.h).
+  void set_camera_ball(const CameraBall& ball) { ball_ = ball; }
+  /// Traces one light path and appends its sensor splats to `out` (and, with a camera ball, the
+  /// beams through it to `ball_beams`).
+  void trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
+             std::vector<Beam>* ball_beams = nullptr) const;
 
  private:
   /// Splat of the connection x -> sensor from medium m leaving along a known side (x already
@@ -50,6 +57,7 @@ class LightTracer {
   /// to the sensor at a distance sampled equiangularly towards the pinhole, by MIS with the
   /// collisions (the splat weighs 1 / dist^2, which collisions alone sample poorly).
   bool sensor_rays_;
+  CameraBall ball_;
 };
 
 }  // namespace femto

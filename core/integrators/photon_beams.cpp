@@ -238,7 +238,8 @@ void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, do
     tracker->segment_integrals(b.medium, {b.o, b.d}, vb, tau_b, opl_b);
     // Light travels along b.d and scatters towards the camera, along -u.
     const double f = hg_eval(-cos_ub, b.g);
-    const RGB value = beta * b.power * (std::exp(-tau_c) * sigma_s * f * norm / std::sqrt(sin2));
+    const double tau = carry_transmittance ? tau_c + tau_b : tau_c;
+    const RGB value = beta * b.power * (std::exp(-tau) * sigma_s * f * norm / std::sqrt(sin2));
     const double time = t + opl_c * t_factor + b.t_ps + opl_b / kSpeedOfLight;
     if (!value.is_finite() || !std::isfinite(time)) {
       ++stats.nonfinite_dropped;

@@ -79,6 +79,13 @@ struct BeamGather {
   /// segment and leave those paths out of their own estimate. Otherwise (all beams) camera paths
   /// gather them only before their first non-specular surface, and do not scatter in media there.
   bool caustic_only = false;
+  /// Long beams (the camera ball's): a beam runs past its collisions, so the crossing also takes
+  /// the beam's own transmittance from its start.
+  bool carry_transmittance = false;
+  /// The hybrid's camera ball (core/integrators/camera_ball.h): its beams, gathered along the
+  /// first `ball_radius` mm of the camera's own segment.
+  const BeamGather* ball = nullptr;
+  double ball_radius = 0;
   /// Adds the in-scattered radiance from beams along [0, s_max) of `ray` in medium m, seen with
   /// throughput beta from camera time t (t_factor converts OPL to time on this segment: 0 on an
   /// unwarped camera segment).

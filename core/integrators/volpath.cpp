@@ -212,6 +212,10 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     if (caustic_beams && med.interacts() && medium_light && !(light_indirect && on_camera_segment))
       beams->gather(m, ray, s_surf, beta, t,
                     unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
+    // Inside the camera ball, light tracing's share comes from the light pieces through it.
+    if (light_indirect && on_camera_segment && beams && beams->ball && med.interacts())
+      beams->ball->gather(m, ray, std::fmin(s_surf, beams->ball_radius), beta, t,
+                          unwarp_ ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
     if (beam_prefix && med.interacts()) {
       // Before the first non-specular surface, light scattered in a medium comes from the beams:
       // the camera path passes through with the segment's exact transmittance.

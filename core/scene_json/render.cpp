@@ -43,9 +43,9 @@ void Loader::roulette(const Json& v, const std::string& p, RouletteDesc& d) cons
 void Loader::render(const Json& v, IntegratorDesc& d) const {
   const std::string p = "/render";
   const Json& o = object(v, p);
-  check_keys(
-      o, p,
-      {"spp", "max_depth", "seed", "integrator", "light_paths", "photons", "russian_roulette"});
+  check_keys(o, p,
+             {"spp", "max_depth", "seed", "integrator", "light_paths", "camera_ball", "photons",
+              "russian_roulette"});
   if (const Json* s = find(o, "spp")) d.spp = int_in(*s, at(p, "spp"), 1, 10000000);
   if (const Json* s = find(o, "integrator")) {
     const std::string k =
@@ -59,6 +59,9 @@ void Loader::render(const Json& v, IntegratorDesc& d) const {
   }
   if (const Json* s = find(o, "light_paths"))
     d.light_paths = integer(*s, at(p, "light_paths"), 1, 1000000000000LL);
+  // Hybrid: the camera ball's radius, mm (0: none; core/integrators/camera_ball.h).
+  if (const Json* s = find(o, "camera_ball"))
+    d.camera_ball_mm = number(*s, at(p, "camera_ball"), within(0, 1e6));
   if (const Json* s = find(o, "photons")) photons(*s, at(p, "photons"), d.photons);
   if (const Json* s = find(o, "russian_roulette"))
     roulette(*s, at(p, "russian_roulette"), d.roulette);

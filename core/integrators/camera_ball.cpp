@@ -1,0 +1,82 @@
+#include "core/integrators/camera_ball.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/constants.h"
+
+namespace femto {
+
+namespace {
+/// Distance from p to triangle abc (closest point by the triangle's Voronoi regions).
+double triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return length(p - a);
+  const Vec3 bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return length(p - b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return length(p - (a + ab * (d1 / (d1 - d3))));
+  const Vec3 cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return length(p - c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return length(p - (a + ac * (d2 / (d2 - d6))));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+  const double denom = 1.0 / (va + vb + vc);
+  return length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
+}
+}  // namespace
+
+double nearest_surface_distance(const SceneDesc& desc, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const ShapeDesc& sh : desc.shapes) {
+    if (sh.type == ShapeDesc::Type::Sphere) {
+      best = std::min(best, std::abs(length(p - sh.center) - sh.radius));
+      continue;
+    }
+    for (const auto& t : sh.triangles)
+      best = std::min(
+          best, triangle_distance(p, sh.vertices[t[0]], sh.vertices[t[1]], sh.vertices[t[2]]));
+  }
+  return best;
+}
+
+CameraBall camera_ball(const Scene& scene, double requested_mm) {
+  CameraBall ball;
+  const Camera& cam = scene.camera();
+  if (!cam.perspective()) return ball;
+  const Medium& med = scene.media()[static_cast<size_t>(scene.camera_medium())];
+  if (!med.interacts()) return ball;
+  const double extent = length(scene.geometry().bounds_max() - scene.geometry().bounds_min());
+  const double r = requested_mm >= 0
+                       ? requested_mm
+                       : std::min(0.01 * (extent > 0 ? extent : 1.0),
+                                  0.5 * nearest_surface_distance(scene.desc(), cam.position()));
+  if (!(r > 0) || !std::isfinite(r)) return ball;
+  ball.centre = cam.position();
+  ball.radius = r;
+  ball.reach = r + camera_ball_gather_radius(ball);
+  return ball;
+}
+
+bool camera_ball_beam(const MediumTracker& tracker, const CameraBall& ball,
+                      const LightVertex& piece, double length_cut, Beam& out) {
+  const Vec3 l = ball.centre - piece.p;
+  const double foot = dot(l, piece.d), h = length(cross(l, piece.d));
+  if (!(h < ball.reach)) return false;
+  const double half = std::sqrt((ball.reach - h) * (ball.reach + h));
+  const double v0 = std::max(0.0, foot - half), v1 = std::min(length_cut, foot + half);
+  if (!(v1 > v0)) return false;
+  double tau = 0, opl = 0;
+  if (v0 > 0) tracker.segment_integrals(piece.medium, {piece.p, piece.d}, v0, tau, opl);
+  out = {piece.p + piece.d * v0,           piece.d,        v1 - v0, piece.beta * std::exp(-tau),
+         piece.t_ps + opl / kSpeedOfLight, piece.sigma_ps, piece.g, piece.medium};
+  return true;
+}
+
+}  // namespace femto
