@@ -132,11 +132,15 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
         j["light_tracing"]["camera_ball"] = {
             {"description",
              "medium points within radius_mm of the pinhole are gathered by the camera's own "
-             "segment from the light paths' pieces through the ball (long beams, 1-D kernel)"},
+             "segment from the light paths' pieces through the ball (long beams, 1-D kernel of "
+             "radius max(slope s, min_radius) at distance s from the pinhole)"},
             {"radius_mm", p.camera_ball_radius},
-            {"gather_radius_mm",
-             {{"first_pass", p.camera_ball_gather_radius_first},
-              {"after_last_pass", p.camera_ball_gather_radius_last}}},
+            {"kernel_slope",
+             {{"first_pass", p.camera_ball_slope_first},
+              {"after_last_pass", p.camera_ball_slope_last}}},
+            {"kernel_min_radius_mm",
+             {{"first_pass", p.camera_ball_r_min_first},
+              {"after_last_pass", p.camera_ball_r_min_last}}},
             {"max_beams_per_pass", p.camera_ball_beams_max}};
       j[beams ? "beam_memory_bytes_peak" : "photon_memory_bytes_peak"] = p.peak_photon_bytes;
       break;

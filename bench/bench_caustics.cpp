@@ -39,6 +39,9 @@ struct Options {
   /// The hybrid's light-traced share, in light paths per pixel per pass: one hybrid line per
   /// value (default-scene mode; 0 = its default, one per four pixels).
   std::vector<double> hybrid_light_paths = {0.0};
+  /// The hybrid's camera ball radius, mm: one hybrid line per value and share (-1: the default
+  /// rule, 0: none).
+  std::vector<double> hybrid_camera_balls = {-1.0};
 };
 
 double now_s() {
@@ -181,10 +184,12 @@ Errors errors(const V* steady, const V* transient, const Reference& ref, const s
   return {std::sqrt(se_s / n) / (m_s / n), std::sqrt(se_t / (n * T)) / (m_t / (n * T))};
 }
 
-/// `per_pixel`: the hybrid's light paths per pixel per pass (0: its default).
+/// `per_pixel`: the hybrid's light paths per pixel per pass (0: its default); `ball`: its camera
+/// ball radius (-1: the default rule).
 RenderResult run(const Scene& scene, IntegratorKind kind, int64_t work, const Options& o,
-                 uint64_t seed, double per_pixel = 0) {
+                 uint64_t seed, double per_pixel = 0, double ball = -1) {
   RenderOptions opt;
+  opt.camera_ball_mm = ball;
   opt.integrator = kind;
   opt.spp = kind == IntegratorKind::Light ? 1 : static_cast<int>(std::max<int64_t>(1, work));
   opt.light_paths = kind == IntegratorKind::Light ? work : 0;
@@ -200,14 +205,14 @@ RenderResult run(const Scene& scene, IntegratorKind kind, int64_t work, const Op
 
 /// Work (spp, passes or light paths) that takes about o.seconds, from a short calibration run.
 int64_t work_for_budget(const Scene& scene, IntegratorKind kind, const Options& o,
-                        double per_pixel = 0) {
+                        double per_pixel = 0, double ball = -1) {
   const int64_t pixels = static_cast<int64_t>(scene.camera().width()) * scene.camera().height();
   // One pass of all beams is slow in this large, thin fog: probe with one.
   const int64_t probe = kind == IntegratorKind::Light   ? 4 * pixels
                         : kind == IntegratorKind::Beams ? 1
                                                         : 4;
   const double t0 = now_s();
-  run(scene, kind, probe, o, 999, per_pixel);
+  run(scene, kind, probe, o, 999, per_pixel, ball);
   const double dt = now_s() - t0;
   return std::max<int64_t>(1, static_cast<int64_t>(static_cast<double>(probe) * o.seconds / dt));
 }
@@ -414,6 +419,26 @@ int main(int argc, char** argv) {
         o.hybrid_light_paths.push_back(x);
         at = comma + 1;
       }
+    } else if (a == "--hybrid-camera-balls") {
+      // R,...: camera ball radii in mm, one hybrid line each per share (-1: default, 0: none)
+      o.hybrid_camera_balls.clear();
+      const std::string v = next();
+      size_t at = 0;
+      while (at <= v.size()) {
+        const size_t comma = std::min(v.find(',', at), v.size());
+        char* end = nullptr;
+        const std::string item = v.substr(at, comma - at);
+        const double x = std::strtod(item.c_str(), &end);
+        if (item.empty() || *end != '\0' || !(x >= -1) || x > 1e6) {
+          std::fprintf(stderr,
+                       "femto-bench-caustics: --hybrid-camera-balls expects radii in mm (-1: the "
+                       "default, 0: none) separated by commas (got '%s')\n",
+                       v.c_str());
+          return 2;
+        }
+        o.hybrid_camera_balls.push_back(x);
+        at = comma + 1;
+      }
     } else if (a == "--scene")
       scene_file = next();
     else if (a == "--through-glass")
@@ -433,14 +458,16 @@ int main(int argc, char** argv) {
     } else if (a == "--help") {
       std::printf(
           "Usage: femto-bench-caustics [--seconds S] [--ref-paths N] [--threads N] [--seed S] "
-          "[--crop X0,Y0,X1,Y1] [--through-glass] [--seeds K] [--hybrid-light-paths X,...]\n"
+          "[--crop X0,Y0,X1,Y1] [--through-glass] [--seeds K] [--hybrid-light-paths X,...] "
+          "[--hybrid-camera-balls R,...]\n"
           "  default crop: the caustic on the "
           "floor; "
           "--crop 100,88,156,128: the fog under the sphere; --through-glass: the spot aimed at "
           "the sphere, its cone inside the sphere's silhouette (all of its light enters the "
           "glass); --seeds K: K renders per estimator, errors as their RMS (1 to 99); "
           "--hybrid-light-paths X,...: one hybrid line per value of its light-traced share, in "
-          "light paths per pixel per pass (0: the default, 0.25)\n"
+          "light paths per pixel per pass (0: the default, 0.25); --hybrid-camera-balls R,...: one "
+          "hybrid line per camera ball radius in mm and share (-1: the default, 0: none)\n"
           "       femto-bench-caustics --scene FILE [--ref-passes N] [--size W,H] [--seconds S] "
           "[--threads N]\n"
           "  a scene whose light camera paths cannot reach (data/scenes/tissue_laser.json): "
@@ -513,20 +540,29 @@ int main(int argc, char** argv) {
     IntegratorKind kind;
     const Reference* ref;
     double per_pixel = 0;  ///< hybrid: light paths per pixel per pass (0: default)
+    double ball = -1;      ///< hybrid: camera ball radius, mm (-1: default)
   };
   std::vector<Case> cases = {
       {"path (housed sphere emitter)", &housed, IntegratorKind::Path, &ref_housed},
       {"path (open sphere emitter)", &sphere, IntegratorKind::Path, &ref_sphere},
       {"light tracing", &spot, IntegratorKind::Light, &ref_spot},
       {"path + photons", &spot, IntegratorKind::Photons, &ref_spot}};
-  for (double x : o.hybrid_light_paths) {
-    char name[64];
-    if (x > 0)
-      std::snprintf(name, sizeof(name), "hybrid, %g light paths/px", x);
-    else
-      std::snprintf(name, sizeof(name), "hybrid");
-    cases.push_back({name, &spot, IntegratorKind::Hybrid, &ref_spot, x});
-  }
+  for (double x : o.hybrid_light_paths)
+    for (double b : o.hybrid_camera_balls) {
+      std::string name = "hybrid";
+      char part[48];
+      if (x > 0) {
+        std::snprintf(part, sizeof(part), ", %g light paths/px", x);
+        name += part;
+      }
+      if (b == 0) {
+        name += ", no ball";
+      } else if (b > 0) {
+        std::snprintf(part, sizeof(part), ", ball %g mm", b);
+        name += part;
+      }
+      cases.push_back({name, &spot, IntegratorKind::Hybrid, &ref_spot, x, b});
+    }
   cases.push_back({"beams", &spot, IntegratorKind::Beams, &ref_spot});
   std::printf("\n%-32s %14s %9s %13s %16s %22s\n", "estimator", "work", "seconds", "steady rRMSE",
               "transient rRMSE", "equal-time transient");
@@ -537,14 +573,14 @@ int main(int argc, char** argv) {
     return std::sqrt(std::max(0.0, e * e - own * own));
   };
   for (const Case& c : cases) {
-    const int64_t work = work_for_budget(*c.scene, c.kind, o, c.per_pixel);
+    const int64_t work = work_for_budget(*c.scene, c.kind, o, c.per_pixel, c.ball);
     // K renders: squared errors and seconds averaged (errors with the reference's own variance
     // taken out, per render, for the corrected figures).
     double sq_steady = 0, sq_transient = 0, sq_steady_c = 0, sq_transient_c = 0, secs = 0;
     for (int k = 0; k < o.seeds; ++k) {
       t0 = now_s();
       const RenderResult r =
-          run(*c.scene, c.kind, work, o, o.seed + static_cast<uint64_t>(k), c.per_pixel);
+          run(*c.scene, c.kind, work, o, o.seed + static_cast<uint64_t>(k), c.per_pixel, c.ball);
       secs += now_s() - t0;
       const Errors ek = errors(r.film.steady(), r.film.transient(), *c.ref, px);
       sq_steady += ek.steady * ek.steady;

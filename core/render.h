@@ -95,9 +95,10 @@ struct RenderResult {
     int64_t beam_paths = 0;
     int64_t hybrid_light_paths = 0;  ///< hybrid: light paths per pass for light tracing's share
     /// Hybrid, camera in a scattering medium: the camera ball (core/integrators/camera_ball.h),
-    /// its gather radius at the first and last pass (mm), and the most beams one pass kept in it.
-    double camera_ball_radius = 0, camera_ball_gather_radius_first = 0,
-           camera_ball_gather_radius_last = 0;
+    /// its gather kernel's slope and smallest radius at the first and after the last pass, and
+    /// the most beams one pass kept in it.
+    double camera_ball_radius = 0, camera_ball_slope_first = 0, camera_ball_slope_last = 0,
+           camera_ball_r_min_first = 0, camera_ball_r_min_last = 0;
     uint64_t camera_ball_beams_max = 0;
     double radius_first = 0, radius_last = 0, bandwidth_first_ps = 0, bandwidth_last_ps = 0;
     uint64_t max_stored_per_pass = 0;

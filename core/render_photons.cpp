@@ -157,16 +157,16 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
             opt.comm);
         const std::vector<Splat>& splats = std::get<0>(traced);
         if (ball.active()) {
-          // The gather radius shrinks with the caustic beams' schedule.
-          const double radius =
-              camera_ball_gather_radius(ball) * beam_schedule.radius() / bd.radius;
+          // The gather kernel shrinks with the caustic beams' schedule.
+          const double ratio = beam_schedule.radius() / bd.radius;
           ball_beams_max = std::max<uint64_t>(ball_beams_max, std::get<1>(traced).size());
-          ball_bvh.build(std::move(std::get<1>(traced)), radius);
+          ball_bvh.build(std::move(std::get<1>(traced)), ball.widest(ratio));
           pass_bytes += ball_bvh.memory_bytes();
           ball_gather.bvh = &ball_bvh;
           ball_gather.scene = &scene;
           ball_gather.tracker = &tracker;
-          ball_gather.radius = radius;
+          ball_gather.radius = ball.r_min * ratio;
+          ball_gather.radius_per_mm = ball.slope * ratio;
           ball_gather.inv_paths = 1.0 / static_cast<double>(indirect_paths);
           ball_gather.kernel = filter;  // the crossing's time is exact: no temporal kernel
           ball_gather.carry_transmittance = true;
@@ -258,9 +258,10 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
     rep.beam_paths = bd.per_pass;
     rep.hybrid_light_paths = indirect_paths;
     rep.camera_ball_radius = ball.radius;
-    rep.camera_ball_gather_radius_first = ball.active() ? camera_ball_gather_radius(ball) : 0.0;
-    rep.camera_ball_gather_radius_last =
-        ball.active() ? camera_ball_gather_radius(ball) * beam_schedule.radius() / bd.radius : 0.0;
+    rep.camera_ball_slope_first = ball.slope;
+    rep.camera_ball_slope_last = ball.slope * beam_schedule.radius() / bd.radius;
+    rep.camera_ball_r_min_first = ball.r_min;
+    rep.camera_ball_r_min_last = ball.r_min * beam_schedule.radius() / bd.radius;
     rep.camera_ball_beams_max = ball_beams_max;
   }
   rep.bandwidth_last_ps = state.photon_bandwidth_last_ps;

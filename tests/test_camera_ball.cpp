@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "agreement.h"
+#include "core/constants.h"
 #include "core/integrators/camera_ball.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
@@ -65,6 +66,48 @@ TEST_CASE("camera ball: the hybrid agrees with camera paths with the camera insi
   require_agreement(cells(hybrid, 4, 5), cells(path, 4, 5), 30, 0.02);
 }
 
+// Catches: the gather kernel next to the pinhole blurring a caustic that passes the camera over
+// the image (a fixed 6 mm radius moved 50% more light into the outer 4 x 4 blocks than light
+// tracing found), or the ball's beams missing light that reached the fog through glass. The
+// spot's light, focused by the sphere, passes within 12 mm of the camera; light tracing has no
+// ball (the reference), so cells are 4 x 4 pixels and the sharp caustic's one-pixel blur stays
+// inside them.
+TEST_CASE("camera ball: the hybrid agrees with light tracing on a caustic passing the camera",
+          "[hybrid][camera_ball][statistical]") {
+  const Scene scene(load_scene_string(R"({
+    "camera": { "type": "perspective", "position": [5, 22, 0], "look_at": [-30, 22, 0], "fov": 60,
+                "resolution": [16, 12] },
+    "time": { "t_start": 0, "bin_width": 50, "bins": 40 },
+    "media": { "fog": { "type": "homogeneous", "sigma_a": 0.002, "sigma_s": 0.03, "g": 0.3 } },
+    "shapes": [
+      { "type": "box", "min": [-59, 1, -59], "max": [59, 90, 59], "medium": "fog" },
+      { "type": "sphere", "center": [-5, 45, 0], "radius": 12,
+        "material": { "type": "dielectric", "eta": 1.5 } } ],
+    "lights": [ { "type": "spot", "position": [-5, 85, 0], "look_at": [-5, 45, 0],
+                  "intensity": 3000, "cone_angle": 16, "falloff_start": 12 } ]
+  })",
+                                      "caustic past the camera", "."));
+  std::vector<TransientFilm> hybrid, light;
+  for (int b = 0; b < 24; ++b) {
+    RenderOptions opt;
+    opt.seed = 500 + static_cast<uint64_t>(b);
+    opt.threads = 2;
+    opt.quiet = true;
+    opt.integrator = IntegratorKind::Light;
+    opt.spp = 1;
+    opt.light_paths = 400000;
+    light.push_back(render(scene, opt).film);
+    opt.integrator = IntegratorKind::Hybrid;
+    opt.spp = 256;
+    opt.light_paths = 0;
+    opt.camera_ball_mm = 12;
+    const RenderResult r = render(scene, opt);
+    CHECK(r.photons.camera_ball_beams_max > 0);
+    hybrid.push_back(r.film);
+  }
+  require_agreement(cells(hybrid, 4, 2), cells(light, 4, 2), 20, 0.03);
+}
+
 // Catches: the default ball not following its rule (1% of the scene's diagonal, at most half the
 // way to the nearest surface), a ball for a camera outside any medium, and a nearest-surface
 // distance that misses triangles' edges and faces or spheres.
@@ -77,7 +120,11 @@ TEST_CASE("camera ball: default radius and nearest surface", "[hybrid][camera_ba
   const double diag = length(Vec3(118, 89, 118));
   const CameraBall ball = camera_ball(scene, -1);
   CHECK(ball.radius == Approx(std::min(0.01 * diag, 8.5)));
-  CHECK(ball.reach == Approx(1.5 * ball.radius));
+  // One pixel's angle at the look_at distance (fov 50 over 12 rows), a quarter of it at the edge.
+  const double pixel = 2 * std::tan(25 * kPi / 180) / 12;
+  CHECK(ball.slope == Approx(pixel));
+  CHECK(ball.r_min == Approx(pixel * ball.radius / 4));
+  CHECK(ball.reach == Approx(ball.radius * (1 + pixel)));
   CHECK(camera_ball(scene, 0).radius == 0.0);
   CHECK(camera_ball(scene, 5).radius == 5.0);
   d.camera.position = Vec3(40, 2, 0);  // 1 mm above the box's floor: half of it

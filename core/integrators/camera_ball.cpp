@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/constants.h"
+#include "core/render.h"
 
 namespace femto {
 
@@ -60,7 +61,12 @@ CameraBall camera_ball(const Scene& scene, double requested_mm) {
   if (!(r > 0) || !std::isfinite(r)) return ball;
   ball.centre = cam.position();
   ball.radius = r;
-  ball.reach = r + camera_ball_gather_radius(ball);
+  const CameraDesc& cd = scene.desc().camera;
+  const double look = length(cd.look_at - cd.position);
+  const double pixel_angle = look > 0 ? pixel_footprint_mm(cd) / look : 0.0;
+  ball.slope = pixel_angle > 0 ? pixel_angle : 1e-3;
+  ball.r_min = ball.slope * r / 4.0;
+  ball.reach = r + ball.widest(1.0);
   return ball;
 }
 

@@ -5,9 +5,13 @@
 // passing at distance h with theta / h: the variance of light tracing there has no bound (one
 // sample 1.25 mm from the pinhole outweighed a pixel's mean 12000 times). Inside the ball the
 // camera's own segment gathers the light pieces that pass through it as beams with their exact
-// transmittance (a 1-D kernel across each beam, whose weight is bounded), so that light tracing
-// splats only points at least `radius` from the pinhole (docs/ARCHITECTURE.md, "Path-space
-// partition").
+// transmittance, so that light tracing splats only points at least `radius` from the pinhole
+// (docs/ARCHITECTURE.md, "Path-space partition"). The gather's 1-D kernel widens along the camera
+// ray, R(s) = max(slope s, r_min): a fixed radius blurs in angle by R / s, which next to the
+// pinhole smeared a caustic passing the camera over much of the image; this one blurs by at most
+// `slope` (one pixel at first) beyond s = r_min / slope, and weighs at most 1 / (2 r_min sin).
+#include <algorithm>
+
 #include "core/integrators/photon_beams.h"
 #include "core/scene.h"
 #include "core/transport/light_walk.h"
@@ -17,7 +21,11 @@ namespace femto {
 struct CameraBall {
   Vec3 centre;
   double radius = 0;  ///< mm; 0: no ball (light tracing splats everything)
-  double reach = 0;   ///< radius + the first gather radius: light pieces farther away are not kept
+  double slope = 0;   ///< first pass's gather radius per mm along the camera ray (radians)
+  double r_min = 0;   ///< first pass's smallest gather radius, mm
+  double reach = 0;   ///< radius + the widest gather radius: light pieces farther away are not kept
+  /// The widest gather radius at the ball's edge when the kernel has shrunk by `ratio`.
+  double widest(double ratio) const { return std::max(r_min, slope * radius) * ratio; }
   bool active() const { return radius > 0; }
 };
 
@@ -27,13 +35,10 @@ double nearest_surface_distance(const SceneDesc& desc, const Vec3& p);
 /// The hybrid's ball, for a perspective camera in a medium that interacts (otherwise none):
 /// `requested_mm` > 0 (checked to hold no surface when the options are read), 0 for none, or by
 /// default min(1% of the scene's bounding-box diagonal, half the distance to the nearest surface),
-/// so that the ball holds no surface and lies in the camera's medium.
+/// so that the ball holds no surface and lies in the camera's medium. The gather kernel starts at a
+/// slope of one pixel's angle (as the caustic beams: one pixel at the look_at distance) and
+/// r_min = slope radius / 4.
 CameraBall camera_ball(const Scene& scene, double requested_mm);
-
-/// First gather radius of the light pieces inside the ball: half its radius.
-inline double camera_ball_gather_radius(const CameraBall& ball) {
-  return 0.5 * ball.radius;
-}
 
 /// The part of the light ray piece `piece` (LightVertex::Kind::Ray, cut at `length`) within
 /// ball.reach of the pinhole, as a beam that starts where that part starts and carries the

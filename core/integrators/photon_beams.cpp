@@ -215,8 +215,8 @@ uint64_t BeamBvh::memory_bytes() const {
 void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, double t,
                         double t_factor, PixelAccumulator& acc, PathStats& stats) const {
   const Medium& med = scene->media()[static_cast<size_t>(m)];
-  const double norm = inv_paths / (2.0 * radius);  // 1-D kernel 1 / (2 R)
-  const double R2 = radius * radius;
+  double norm = inv_paths / (2.0 * radius);  // 1-D kernel 1 / (2 R)
+  double R2 = radius * radius;
   bvh->query(ray.o, ray.d, s_max, [&](const Beam& b, const BeamBvh::Piece& piece) {
     if (b.medium != m) return;
     // Closest approach of the camera line o + tc u and the beam line b.o + vb b.d.
@@ -228,6 +228,11 @@ void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, do
     // The piece that holds the closest approach owns the crossing (pieces tile the beam).
     if (!(tc >= 0 && tc < s_max && vb >= piece.v0 && vb < piece.v1 && vb < b.length)) return;
     const Vec3 xc = ray.at(tc);
+    if (radius_per_mm > 0) {
+      const double R = std::max(radius, radius_per_mm * tc);
+      norm = inv_paths / (2.0 * R);
+      R2 = R * R;
+    }
     if (length_squared(xc - (b.o + b.d * vb)) >= R2) return;
     const double sigma_s = med.type == Medium::Type::Grid
                                ? med.grid->sigma_t_at(xc) * med.grid->albedo_at(xc)

@@ -70,7 +70,10 @@ struct BeamGather {
   const BeamBvh* bvh = nullptr;
   const Scene* scene = nullptr;
   const MediumTracker* tracker = nullptr;
-  double radius = 1;        ///< R_j, mm
+  double radius = 1;  ///< R_j, mm (with radius_per_mm: the smallest)
+  /// Kernel widening along the camera ray (the camera ball): R = max(radius, radius_per_mm tc)
+  /// at the crossing's distance tc from the ray's origin; 0: R = radius.
+  double radius_per_mm = 0;
   double bandwidth_ps = 0;  ///< T_j, ps
   double inv_paths = 1;     ///< 1 / light paths traced in the pass
   TemporalFilter kernel;

@@ -212,8 +212,10 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     if (caustic_beams && med.interacts() && medium_light && !(light_indirect && on_camera_segment))
       beams->gather(m, ray, s_surf, beta, t,
                     unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
-    // Inside the camera ball, light tracing's share comes from the light pieces through it.
-    if (light_indirect && on_camera_segment && beams && beams->ball && med.interacts())
+    // Inside the camera ball, light tracing's share comes from the light pieces through it (the
+    // ray still starts at the pinhole: no boundary crossed yet).
+    if (light_indirect && on_camera_segment && null_crossings == 0 && beams && beams->ball &&
+        med.interacts())
       beams->ball->gather(m, ray, std::fmin(s_surf, beams->ball_radius), beta, t,
                           unwarp_ ? 0.0 : 1.0 / kSpeedOfLight, acc, stats);
     if (beam_prefix && med.interacts()) {
