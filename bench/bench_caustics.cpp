@@ -44,6 +44,22 @@ struct Options {
   std::vector<double> hybrid_camera_balls = {-1.0};
 };
 
+/// Parses "X,Y,..." into `out`: numbers in [lo, hi]; false on an empty or bad item.
+bool number_list(const std::string& v, double lo, double hi, std::vector<double>& out) {
+  out.clear();
+  size_t at = 0;
+  while (at <= v.size()) {
+    const size_t comma = std::min(v.find(',', at), v.size());
+    char* end = nullptr;
+    const std::string item = v.substr(at, comma - at);
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !(x >= lo) || x > hi) return false;
+    out.push_back(x);
+    at = comma + 1;
+  }
+  return true;
+}
+
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -401,43 +417,23 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--hybrid-light-paths") {
       // X,Y,...: light paths per pixel per pass, one hybrid line each (0: the default)
-      o.hybrid_light_paths.clear();
       const std::string v = next();
-      size_t at = 0;
-      while (at <= v.size()) {
-        const size_t comma = std::min(v.find(',', at), v.size());
-        char* end = nullptr;
-        const std::string item = v.substr(at, comma - at);
-        const double x = std::strtod(item.c_str(), &end);
-        if (item.empty() || *end != '\0' || !(x >= 0) || x > 1000) {
-          std::fprintf(stderr,
-                       "femto-bench-caustics: --hybrid-light-paths expects numbers 0 to 1000 "
-                       "separated by commas (got '%s')\n",
-                       v.c_str());
-          return 2;
-        }
-        o.hybrid_light_paths.push_back(x);
-        at = comma + 1;
+      if (!number_list(v, 0, 1000, o.hybrid_light_paths)) {
+        std::fprintf(stderr,
+                     "femto-bench-caustics: --hybrid-light-paths expects numbers 0 to 1000 "
+                     "separated by commas (got '%s')\n",
+                     v.c_str());
+        return 2;
       }
     } else if (a == "--hybrid-camera-balls") {
       // R,...: camera ball radii in mm, one hybrid line each per share (-1: default, 0: none)
-      o.hybrid_camera_balls.clear();
       const std::string v = next();
-      size_t at = 0;
-      while (at <= v.size()) {
-        const size_t comma = std::min(v.find(',', at), v.size());
-        char* end = nullptr;
-        const std::string item = v.substr(at, comma - at);
-        const double x = std::strtod(item.c_str(), &end);
-        if (item.empty() || *end != '\0' || !(x >= -1) || x > 1e6) {
-          std::fprintf(stderr,
-                       "femto-bench-caustics: --hybrid-camera-balls expects radii in mm (-1: the "
-                       "default, 0: none) separated by commas (got '%s')\n",
-                       v.c_str());
-          return 2;
-        }
-        o.hybrid_camera_balls.push_back(x);
-        at = comma + 1;
+      if (!number_list(v, -1, 1e6, o.hybrid_camera_balls)) {
+        std::fprintf(stderr,
+                     "femto-bench-caustics: --hybrid-camera-balls expects radii in mm (-1: the "
+                     "default, 0: none) separated by commas (got '%s')\n",
+                     v.c_str());
+        return 2;
       }
     } else if (a == "--scene")
       scene_file = next();

@@ -11,12 +11,14 @@
 
 namespace femto {
 
-namespace {
-
+/// A sphere as Embree's user geometry holds it (outside the anonymous namespace: Geometry::Impl
+/// keeps one, and a unity build would see that as a member of internal linkage).
 struct SphereData {
   Vec3 center;
   double radius;
 };
+
+namespace {
 
 // Nearest root of |o + s d - c|^2 = r^2 in (s_min, s_max), computed in double precision.
 bool intersect_sphere(const SphereData& sp, const Vec3& o, const Vec3& d, double s_min,
@@ -79,7 +81,6 @@ void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
   rh->hit.geomID = args->geomID;
   rh->hit.instID[0] = args->context->instID[0];
 }
-
 
 }  // namespace
 

@@ -34,6 +34,32 @@ const char* kFogAroundCamera = R"({
   "lights": [ { "type": "point", "position": [-5, 45, 0], "intensity": 3000 } ]
 })";
 
+/// 24 hybrid renders of 256 passes with a 12 mm camera ball against 24 renders by `reference`
+/// (camera paths, 1024 spp, or light tracing, 400000 paths): 4 x 4 pixel cells of `group` bins.
+void ball_agrees(const Scene& scene, IntegratorKind reference, uint64_t seed0, int group,
+                 int min_cells, double resolution) {
+  std::vector<TransientFilm> hybrid, ref;
+  for (int b = 0; b < 24; ++b) {
+    RenderOptions opt;
+    opt.seed = seed0 + static_cast<uint64_t>(b);
+    opt.threads = 2;
+    opt.quiet = true;
+    opt.integrator = reference;
+    opt.spp = reference == IntegratorKind::Light ? 1 : 1024;
+    opt.light_paths = reference == IntegratorKind::Light ? 400000 : 0;
+    ref.push_back(render(scene, opt).film);
+    opt.integrator = IntegratorKind::Hybrid;
+    opt.spp = 256;
+    opt.light_paths = 0;
+    opt.camera_ball_mm = 12;
+    const RenderResult r = render(scene, opt);
+    REQUIRE(r.photons.camera_ball_radius == 12.0);
+    CHECK(r.photons.camera_ball_beams_max > 0);
+    hybrid.push_back(r.film);
+  }
+  require_agreement(cells(hybrid, 4, group), cells(ref, 4, group), min_cells, resolution);
+}
+
 }  // namespace
 
 // Catches: the camera segment's gather of the light pieces through the ball mis-weighted (their
@@ -46,24 +72,7 @@ const char* kFogAroundCamera = R"({
 TEST_CASE("camera ball: the hybrid agrees with camera paths with the camera inside dense fog",
           "[hybrid][camera_ball][statistical]") {
   const Scene scene(load_scene_string(kFogAroundCamera, "fog around the camera", "."));
-  std::vector<TransientFilm> hybrid, path;
-  for (int b = 0; b < 24; ++b) {
-    RenderOptions opt;
-    opt.seed = 300 + static_cast<uint64_t>(b);
-    opt.threads = 2;
-    opt.quiet = true;
-    opt.integrator = IntegratorKind::Path;
-    opt.spp = 1024;
-    path.push_back(render(scene, opt).film);
-    opt.integrator = IntegratorKind::Hybrid;
-    opt.spp = 256;
-    opt.camera_ball_mm = 12;
-    const RenderResult r = render(scene, opt);
-    REQUIRE(r.photons.camera_ball_radius == 12.0);
-    CHECK(r.photons.camera_ball_beams_max > 0);
-    hybrid.push_back(r.film);
-  }
-  require_agreement(cells(hybrid, 4, 5), cells(path, 4, 5), 30, 0.02);
+  ball_agrees(scene, IntegratorKind::Path, 300, 5, 30, 0.02);
 }
 
 // Catches: the gather kernel next to the pinhole blurring a caustic that passes the camera over
@@ -87,25 +96,7 @@ TEST_CASE("camera ball: the hybrid agrees with light tracing on a caustic passin
                   "intensity": 3000, "cone_angle": 16, "falloff_start": 12 } ]
   })",
                                       "caustic past the camera", "."));
-  std::vector<TransientFilm> hybrid, light;
-  for (int b = 0; b < 24; ++b) {
-    RenderOptions opt;
-    opt.seed = 500 + static_cast<uint64_t>(b);
-    opt.threads = 2;
-    opt.quiet = true;
-    opt.integrator = IntegratorKind::Light;
-    opt.spp = 1;
-    opt.light_paths = 400000;
-    light.push_back(render(scene, opt).film);
-    opt.integrator = IntegratorKind::Hybrid;
-    opt.spp = 256;
-    opt.light_paths = 0;
-    opt.camera_ball_mm = 12;
-    const RenderResult r = render(scene, opt);
-    CHECK(r.photons.camera_ball_beams_max > 0);
-    hybrid.push_back(r.film);
-  }
-  require_agreement(cells(hybrid, 4, 2), cells(light, 4, 2), 20, 0.03);
+  ball_agrees(scene, IntegratorKind::Light, 500, 2, 20, 0.03);
 }
 
 // Catches: the default ball not following its rule (1% of the scene's diagonal, at most half the

@@ -16,7 +16,7 @@
 namespace femto {
 
 namespace {
-constexpr int64_t kChunk = 256;  // light paths per task: the unit of deterministic ordering
+constexpr int64_t kBeamChunk = 256;  // light paths per task: the unit of deterministic ordering
 /// Beam streams are keyed apart from camera pixels and photons.
 constexpr uint64_t kBeamStream = 0x6000000000000000ULL;
 constexpr uint32_t kLeafSize = 2;
@@ -260,7 +260,8 @@ std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64
                               const distributed::Comm* comm) {
   const MediumTracker tracker(scene);
   return trace_in_chunks<Beam>(
-      count, kChunk, stats, [&](int64_t i, std::vector<Beam>& out, PathStats& st) {
+      count, kBeamChunk, stats,
+      [&](int64_t i, std::vector<Beam>& out, PathStats& st) {
         Rng rng = Rng::for_sample(seed, kBeamStream + static_cast<uint64_t>(pass),
                                   static_cast<uint64_t>(i));
         walk_light_path(

@@ -14,7 +14,7 @@
 namespace femto {
 
 namespace {
-constexpr int64_t kChunk = 1024;  // photons per task: the unit of deterministic ordering
+constexpr int64_t kPhotonChunk = 1024;  // photons per task: the unit of deterministic ordering
 /// Photon streams are keyed apart from camera pixels (whose keys are < 2^62).
 constexpr uint64_t kPhotonStream = 0x5000000000000000ULL;
 /// Normals closer than this (cosine) count as the same surface in a gather.
@@ -82,7 +82,8 @@ std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, i
                                   const distributed::Comm* comm) {
   const MediumTracker tracker(scene);
   return trace_in_chunks<Photon>(
-      count, kChunk, stats, [&](int64_t i, std::vector<Photon>& out, PathStats& st) {
+      count, kPhotonChunk, stats,
+      [&](int64_t i, std::vector<Photon>& out, PathStats& st) {
         Rng rng = Rng::for_sample(seed, kPhotonStream + static_cast<uint64_t>(pass),
                                   static_cast<uint64_t>(i));
         walk_light_path(scene, tracker, rng, max_depth, t_cut_ps, st, [&](const LightVertex& v) {
