@@ -563,6 +563,7 @@ int main(int argc, char** argv) {
   std::printf("\n%-32s %14s %9s %13s %16s %22s\n", "estimator", "work", "seconds", "steady rRMSE",
               "transient rRMSE", "equal-time transient");
   double base_steady = 0, base_transient = 0, base_steady_c = 0, base_transient_c = 0;
+  double base_median_steady = 0, base_median_transient = 0;
   // An error against a reference holds the reference's own variance too (independent of the
   // estimator's): taking it out estimates the error against the exact image.
   auto without_ref = [](double e, double own) {
@@ -573,6 +574,9 @@ int main(int argc, char** argv) {
     // K renders: squared errors and seconds averaged (errors with the reference's own variance
     // taken out, per render, for the corrected figures).
     double sq_steady = 0, sq_transient = 0, sq_steady_c = 0, sq_transient_c = 0, secs = 0;
+    // Per render (reference's own error taken out): the median is a typical render's error,
+    // which one rare firefly among K renders cannot move (the RMS holds the tail).
+    std::vector<double> each_steady, each_transient;
     for (int k = 0; k < o.seeds; ++k) {
       t0 = now_s();
       const RenderResult r =
@@ -585,6 +589,8 @@ int main(int argc, char** argv) {
                    ct = without_ref(ek.transient, c.ref->own.transient);
       sq_steady_c += cs * cs;
       sq_transient_c += ct * ct;
+      each_steady.push_back(cs);
+      each_transient.push_back(ct);
     }
     secs /= o.seeds;
     const Errors e{std::sqrt(sq_steady / o.seeds), std::sqrt(sq_transient / o.seeds)};
@@ -606,6 +612,20 @@ int main(int argc, char** argv) {
         "transient %.4f (%5.1fx)\n",
         "", "", "", "", "", steady_c, base_steady_c / steady_c, transient_c,
         base_transient_c / transient_c);
+    auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      const size_t n = v.size();
+      return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    };
+    const double median_steady = median(each_steady) * scale,
+                 median_transient = median(each_transient) * scale;
+    if (&c == &cases[0])
+      base_median_steady = median_steady, base_median_transient = median_transient;
+    std::printf(
+        "%-32s %14s %9s %13s %16s median of the renders: steady %.4f (%5.1fx), transient %.4f "
+        "(%5.1fx)\n",
+        "", "", "", "", "", median_steady, base_median_steady / median_steady, median_transient,
+        base_median_transient / median_transient);
     std::fflush(stdout);
   }
   std::printf(
