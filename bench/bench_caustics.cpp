@@ -24,6 +24,7 @@
 
 using namespace femto;
 using femto::bench::cpu_model;
+using femto::bench::now_s;
 
 namespace {
 
@@ -44,6 +45,14 @@ struct Options {
   std::vector<double> hybrid_camera_balls = {-1.0};
 };
 
+/// Median, the mean of the middle two for an even count (bench::median takes the upper one; the
+/// figures in docs/PERFORMANCE.md were made with this one).
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 /// Parses "X,Y,..." into `out`: numbers in [lo, hi]; false on an empty or bad item.
 bool number_list(const std::string& v, double lo, double hi, std::vector<double>& out) {
   out.clear();
@@ -58,10 +67,6 @@ bool number_list(const std::string& v, double lo, double hi, std::vector<double>
     at = comma + 1;
   }
   return true;
-}
-
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 /// The default scene with its spot light replaced by an emissive sphere of radius r at the same
@@ -612,13 +617,8 @@ int main(int argc, char** argv) {
         "transient %.4f (%5.1fx)\n",
         "", "", "", "", "", steady_c, base_steady_c / steady_c, transient_c,
         base_transient_c / transient_c);
-    auto median = [](std::vector<double> v) {
-      std::sort(v.begin(), v.end());
-      const size_t n = v.size();
-      return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    };
-    const double median_steady = median(each_steady) * scale,
-                 median_transient = median(each_transient) * scale;
+    const double median_steady = median_of(each_steady) * scale,
+                 median_transient = median_of(each_transient) * scale;
     if (&c == &cases[0])
       base_median_steady = median_steady, base_median_transient = median_transient;
     std::printf(

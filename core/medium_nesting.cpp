@@ -77,7 +77,8 @@ Vec3 closest_on_triangle(const Vec3& p, const Tri& t) {
   return t.a + ab * (vb * denom) + ac * (vc * denom);
 }
 
-// Distance from p to the surface of a triangle shape.
+}  // namespace
+
 double distance_to_triangles(const ShapeDesc& s, const Vec3& p) {
   double best = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < s.triangles.size(); ++i) {
@@ -86,6 +87,8 @@ double distance_to_triangles(const ShapeDesc& s, const Vec3& p) {
   }
   return best;
 }
+
+namespace {
 
 // Parameter s of the crossing of the line o + s d with triangle t, or NaN; crossings within
 // rel_tol (barycentric) of the triangle's edges do not count.

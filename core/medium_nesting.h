@@ -7,6 +7,9 @@
 
 namespace femto {
 
+/// Distance from p to the surface of a triangle shape (quad, box, mesh).
+double distance_to_triangles(const ShapeDesc& s, const Vec3& p);
+
 /// Whether shape s bounds a region of its own medium (a `medium`, or a refracting material).
 bool bounds_a_medium(const ShapeDesc& s);
 

@@ -5,33 +5,10 @@
 #include <limits>
 
 #include "core/constants.h"
+#include "core/medium_nesting.h"
 #include "core/render.h"
 
 namespace femto {
-
-namespace {
-/// Distance from p to triangle abc (closest point by the triangle's Voronoi regions).
-double triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return length(p - a);
-  const Vec3 bp = p - b;
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return length(p - b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return length(p - (a + ab * (d1 / (d1 - d3))));
-  const Vec3 cp = p - c;
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return length(p - c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return length(p - (a + ac * (d2 / (d2 - d6))));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
-  const double denom = 1.0 / (va + vb + vc);
-  return length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
-}
-}  // namespace
 
 double nearest_surface_distance(const SceneDesc& desc, const Vec3& p) {
   double best = std::numeric_limits<double>::infinity();
@@ -40,9 +17,7 @@ double nearest_surface_distance(const SceneDesc& desc, const Vec3& p) {
       best = std::min(best, std::abs(length(p - sh.center) - sh.radius));
       continue;
     }
-    for (const auto& t : sh.triangles)
-      best = std::min(
-          best, triangle_distance(p, sh.vertices[t[0]], sh.vertices[t[1]], sh.vertices[t[2]]));
+    best = std::min(best, distance_to_triangles(sh, p));
   }
   return best;
 }
