@@ -92,14 +92,18 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
     }
     if (indirect_only) {
       if (v.kind == LightVertex::Kind::Surface) {
-        surfaced = true;
         const bool diffuse = v.bsdf->is_diffuse();
+        // The light's own caustic seen directly, light -> (S|G)+ -> D -> sensor: the photons'
+        // prefix, splatted exactly here where the camera sees D without a surface between.
+        const bool caustic = diffuse && surfaced && !scattered;
+        surfaced = true;
         scattered = scattered || diffuse;
         // Light scattered in a medium onto a diffuse surface, straight or through specular
         // surfaces (light -> X* M S* -> D -> sensor), and light from a diffuse surface through
         // specular ones (light -> X* D S+ -> D -> sensor): the caustics of what has scattered.
         const bool splat_here =
-            diffuse && (last == Last::Medium || (last == Last::Diffuse && specular_since));
+            caustic ||
+            (diffuse && (last == Last::Medium || (last == Last::Diffuse && specular_since)));
         if (v.bsdf->is_delta()) {
           specular_since = true;
         } else {

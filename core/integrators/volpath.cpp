@@ -328,7 +328,9 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     const Frame frame(hit.ng);
     const Vec3 wo = frame.to_local(-ray.d);
     const bool wo_outside = front;
-    if (photons && bsdf.is_diffuse()) photons->gather(bsdf, hit, frame, wo, beta, t, acc, stats);
+    // At x_c a diffuse surface light tracing owns the photons' light -> (S|G)+ -> x_c too.
+    if (photons && bsdf.is_diffuse() && !(light_indirect && first_vertex))
+      photons->gather(bsdf, hit, frame, wo, beta, t, acc, stats);
     // Next-event estimation, except where a photon owns the path (light -> glossy -> diffuse).
     if (!bsdf.is_delta() && !(!bsdf.is_diffuse() && owned(last)))
       estimate_direct_surface(bsdf, hit, frame, wo, wo_outside, m, beta, t, rng, acc, stats);
