@@ -121,14 +121,14 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
             {"schedule",
              "R_{j+1} = R_j ((j + alpha) / (j + 1))^(1 - beta_t), T_{j+1} = T_j ((j + alpha) / (j "
              "+ 1))^beta_t"}};
-      if (p.hybrid_beams)
+      if (p.hybrid_light_paths > 0)
         j["light_tracing"] = {
             {"description",
              "light paths splatted to the sensor for the light that camera paths leave to them "
              "(docs/ARCHITECTURE.md, \"Path-space partition\")"},
             {"light_paths_per_pass", p.hybrid_light_paths},
             {"set_by", opt.light_paths > 0 ? "light_paths" : "default: one per four pixels"}};
-      if (p.hybrid_beams && p.camera_ball_radius > 0)
+      if (p.hybrid_light_paths > 0 && p.camera_ball_radius > 0)
         j["light_tracing"]["camera_ball"] = {
             {"description",
              "medium points within radius_mm of the pinhole are gathered by the camera's own "

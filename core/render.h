@@ -134,10 +134,13 @@ struct RenderMemory {
 RenderMemory render_memory(int width, int height, int bins, const RenderOptions& options, int threads,
                            bool kernel, int first_pass_spp, bool multipart_frames);
 
-/// The integrator `kind` stands for in this scene: Auto becomes Photons when the scene has
-/// delta lights (point, spot, laser) and non-diffuse surfaces and the film is a histogram, else
-/// Path. `why` says which rule decided.
+/// The integrator `kind` stands for in this scene: Auto becomes Hybrid when the scene has delta
+/// lights (point, spot, laser) and non-diffuse surfaces and the film is a histogram (Beams when
+/// a scattering medium lies behind specular surfaces only), else Path. `why` says which rule
+/// decided.
 IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, std::string& why);
+/// Whether a medium of the scene scatters (a voxel medium, or sigma_s > 0).
+bool has_scattering_medium(const SceneDesc& scene);
 const char* integrator_name(IntegratorKind kind);
 
 /// Beam light paths per pass when the scene sets none: half the film's pixels, within

@@ -39,7 +39,10 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const IntegratorKind kind = opt.integrator;
   // Photons: photons on surfaces; beams: all beams; hybrid: photons and caustic beams.
   const bool use_photons = kind != IntegratorKind::Beams;
-  const bool use_beams = kind != IntegratorKind::Photons;
+  const bool hybrid = kind == IntegratorKind::Hybrid;
+  // The hybrid's caustic beams: none without a scattering medium (they would never be gathered).
+  const bool caustic_beams = hybrid && has_scattering_medium(scene.desc());
+  const bool use_beams = kind == IntegratorKind::Beams || caustic_beams;
   // Photons are stored at diffuse surfaces only: without one, tracing them would cost a share of
   // every pass and change nothing (a hybrid render of glass in fog).
   const bool trace_surface_photons =
@@ -47,9 +50,8 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       std::any_of(scene.desc().shapes.begin(), scene.desc().shapes.end(), [](const ShapeDesc& sh) {
         return sh.material.type == MaterialDesc::Type::Diffuse;
       });
-  const bool caustic_beams = kind == IntegratorKind::Hybrid;
   PhotonDesc photon_opts = opt.photons;
-  if (caustic_beams && photon_opts.per_pass <= 0)
+  if (hybrid && photon_opts.per_pass <= 0)
     photon_opts.per_pass = default_hybrid_photons_per_pass(static_cast<int64_t>(W) * H);
   const PhotonDesc pd = progressive_settings(
       scene, kind == IntegratorKind::Beams ? IntegratorKind::Beams : IntegratorKind::Photons,
@@ -64,7 +66,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   // Hybrid: light paths splatted from their medium vertices once they have scattered (off a
   // diffuse surface or in a medium), which camera paths then leave out: one light path per four
   // pixels per pass (docs/ARCHITECTURE.md, "Path-space partition").
-  const bool light_indirect = caustic_beams;
+  const bool light_indirect = hybrid;
   const int64_t indirect_paths = hybrid_light_paths_per_pass(opt, static_cast<int64_t>(W) * H);
   // Photon times include the emission offset: the window end plus the widest pulse spread.
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
@@ -97,7 +99,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                               LightTracer::Vertices::MediumIndirect);
   // A camera inside a scattering medium: the medium points next to the pinhole are the camera
   // paths', gathered from the light pieces through the ball (core/integrators/camera_ball.h).
-  const CameraBall ball = light_indirect ? camera_ball(scene, opt.camera_ball_mm) : CameraBall{};
+  const CameraBall ball = caustic_beams ? camera_ball(scene, opt.camera_ball_mm) : CameraBall{};
   indirect_tracer.set_camera_ball(ball);
   BeamBvh ball_bvh;
   uint64_t ball_beams_max = 0;
@@ -247,6 +249,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   rep.radius_first = R1;
   rep.bandwidth_first_ps = T1;
   rep.radius_last = state.photon_radius_last;
+  if (hybrid) rep.hybrid_light_paths = indirect_paths;
   if (caustic_beams) {
     rep.hybrid_beams = true;
     rep.beam_radius_first = bd.radius;
@@ -256,7 +259,6 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
     rep.beam_alpha = bd.alpha;
     rep.beam_beta_t = bd.beta_t;
     rep.beam_paths = bd.per_pass;
-    rep.hybrid_light_paths = indirect_paths;
     rep.camera_ball_radius = ball.radius;
     rep.camera_ball_slope_first = ball.slope;
     rep.camera_ball_slope_last = ball.slope * beam_schedule.radius() / bd.radius;

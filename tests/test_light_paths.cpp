@@ -211,6 +211,22 @@ TEST_CASE("camera paths + photons agree with light tracing on a caustic from a p
   require_agreement(ph, lt, 10);
 }
 
+// Catches: without a scattering medium, the hybrid (auto's choice there) dropping or double
+// counting the caustic seen directly (light tracing's splats; no photons at the camera's first
+// vertex), or failing when it traces no caustic beams (max |z| 53 without the splat). The photons
+// test above checks the photons themselves on the same scene.
+TEST_CASE("the hybrid without a medium agrees with light tracing on a caustic from a point light",
+          "[light-paths][hybrid][statistical]") {
+  const SceneDesc d = caustic_scene(axis_of(250, 60, 8));
+  std::string why;
+  CHECK(resolve_integrator(d, IntegratorKind::Auto, why) == IntegratorKind::Hybrid);
+  const Scene scene(d);
+  const PhotonDesc pd = progressive(4000, 0.5, 1.0);
+  const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 1024, 24, 730, pd), 3, 2);
+  const auto lt = cells(batches(scene, IntegratorKind::Light, 80000, 24, 830), 3, 2);
+  require_agreement(hy, lt, 10);
+}
+
 // Catches: camera paths still counting light -> glass -> floor -> camera when photons are on
 // (double counting), or dropping other paths: an emissive sphere behind glass is reachable by
 // camera paths alone, so path-only and path + photons must agree.
