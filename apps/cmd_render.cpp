@@ -80,11 +80,12 @@ const char* kRenderHelp =
     "                     progressive photon mapping of caustics on surfaces), beams (camera\n"
     "                     paths + transient progressive photon beams for all light scattered\n"
     "                     in media) or hybrid (camera paths + surface photons + beams for\n"
-    "                     caustics inside media + light paths for the light that reaches the\n"
-    "                     fog the camera sees after scattering). auto: hybrid when the scene\n"
-    "                     has point, spot or laser lights, non-diffuse surfaces and a\n"
-    "                     scattering medium; photons with such lights and surfaces but no\n"
-    "                     scattering medium; else path (femto info prints the choice and why)\n"
+    "                     caustics inside media + light paths for the caustic on the surface\n"
+    "                     the camera sees and the light that reaches the fog the camera sees\n"
+    "                     after scattering). auto: with point, spot or laser lights and\n"
+    "                     non-diffuse surfaces, beams when a scattering medium lies behind\n"
+    "                     specular surfaces only, else hybrid (with or without a medium);\n"
+    "                     else path (femto info prints the choice and why)\n"
     "  --light-paths N    light tracing: light paths in all, e.g. 4e7 (default spp x pixels);\n"
     "                     hybrid: its light-traced share in all, spread over the spp passes\n"
     "                     (default one path per four pixels per pass)\n"
@@ -315,8 +316,9 @@ int cmd_render(const std::vector<std::string>& argv, const std::string& command_
   // writing the outputs (core/render.h, render_memory).
   const int hardware_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads_used = opt.threads > 0 ? std::min(opt.threads, hardware_threads) : hardware_threads;
-  const RenderMemory mem = render_memory(cam.width, cam.height, axis.bins, opt, threads_used, kernel_film,
-                                         rec.first_pass_spp, out.frames == OutputOptions::Frames::Multipart);
+  const RenderMemory mem = render_memory(
+      cam.width, cam.height, axis.bins, opt, threads_used, kernel_film, rec.first_pass_spp,
+      out.frames == OutputOptions::Frames::Multipart, has_scattering_medium(desc));
   const uint64_t render_bytes = mem.peak();
   if (render_bytes > max_memory)
     throw InputError("render needs " + cli::format_bytes(render_bytes) + " (film " + cli::format_bytes(mem.film) +

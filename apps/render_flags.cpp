@@ -203,9 +203,7 @@ RenderSetup apply_render_overrides(SceneDesc& desc, const RenderOverrides& o,
     throw InputError(command + ": " + o.photon_flag +
                      ": applies to photon mapping and photon beams only, but the integrator is \"" +
                      integrator_name(kind) + "\"; add --integrator photons or beams");
-  const bool scattering = std::any_of(
-      desc.media.begin(), desc.media.end(),
-      [](const MediumDesc& m) { return m.type == MediumDesc::Type::Vdb || m.medium.sigma_s > 0; });
+  const bool scattering = has_scattering_medium(desc);
   if (kind == IntegratorKind::Beams && !scattering)
     throw InputError(
         where +
@@ -221,7 +219,8 @@ RenderSetup apply_render_overrides(SceneDesc& desc, const RenderOverrides& o,
                      ": --camera-ball: applies to --integrator hybrid only, but the "
                      "integrator is \"" +
                      integrator_name(kind) + "\"");
-  if (kind == IntegratorKind::Hybrid && desc.integrator.camera_ball_mm > 0) {
+  // Without a scattering medium there is no ball (core/integrators/camera_ball.h).
+  if (kind == IntegratorKind::Hybrid && scattering && desc.integrator.camera_ball_mm > 0) {
     // The ball must hold no surface: camera paths gather only the camera's medium inside it.
     const double nearest = nearest_surface_distance(desc, desc.camera.position);
     if (!(desc.integrator.camera_ball_mm < nearest)) {

@@ -78,15 +78,20 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
     case IntegratorKind::Hybrid: {
       const bool beams = kind == IntegratorKind::Beams;
       const auto& p = result.photons;
-      j["description"] = beams ? "camera paths + transient progressive photon beams: every "
-                                 "light-path segment in a scattering "
-                                 "medium is a beam; light scattered in media before a camera "
-                                 "path's first non-specular surface "
-                                 "comes from the beams gathered along its segments"
-                               : "camera paths + transient progressive photon mapping: photons "
-                                 "that reach a diffuse surface "
-                                 "through non-diffuse surfaces are gathered there; camera paths "
-                                 "leave those paths out";
+      j["description"] =
+          beams ? "camera paths + transient progressive photon beams: every light-path segment in "
+                  "a scattering medium is a beam; light scattered in media before a camera "
+                  "path's first non-specular surface comes from the beams gathered along its "
+                  "segments"
+          : kind == IntegratorKind::Hybrid
+              ? "camera paths + transient progressive photon mapping + caustic photon beams + "
+                "light tracing: photons that reach a diffuse surface through non-diffuse "
+                "surfaces are gathered there, except on the surface a camera path meets first, "
+                "where light tracing splats that light; caustic beams in scattering media; camera "
+                "paths leave those paths out (docs/ARCHITECTURE.md, \"Path-space partition\")"
+              : "camera paths + transient progressive photon mapping: photons that reach a "
+                "diffuse surface through non-diffuse surfaces are gathered there; camera paths "
+                "leave those paths out";
       j["passes"] = p.passes;
       j["camera_samples_per_pass"] = 1;
       j["photons_per_pass"] = p.per_pass;

@@ -211,7 +211,8 @@ RenderResult render(const Scene& scene, const RenderOptions& opt) {
 }
 
 RenderMemory render_memory(int width, int height, int bins, const RenderOptions& opt, int threads,
-                           bool kernel, int first_pass_spp, bool multipart_frames) {
+                           bool kernel, int first_pass_spp, bool multipart_frames,
+                           bool scattering_medium) {
   RenderMemory m;
   const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
   const uint64_t B = static_cast<uint64_t>(bins);
@@ -230,8 +231,10 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
                               ? default_hybrid_photons_per_pass(static_cast<int64_t>(pixels))
                               : 200000);
   // Beams: an estimate (the beams a light path leaves depend on the scene), about 8 per path
-  // for all beams; the hybrid's caustic beams end at the path's first scattering, about 2.
-  if (opt.integrator == IntegratorKind::Beams || opt.integrator == IntegratorKind::Hybrid)
+  // for all beams; the hybrid's caustic beams end at the path's first scattering, about 2, and
+  // without a scattering medium it traces none.
+  if (opt.integrator == IntegratorKind::Beams ||
+      (opt.integrator == IntegratorKind::Hybrid && scattering_medium))
     m.integrator += beam_pass_bytes(
         (opt.integrator == IntegratorKind::Beams ? 8 : 2) *
         static_cast<uint64_t>(

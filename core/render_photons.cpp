@@ -37,7 +37,8 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   const TemporalFilter filter(axis, TemporalFilter::Kind::Histogram);
   const VolPathIntegrator integrator(scene, filter, opt.max_depth, opt.roulette);
   const IntegratorKind kind = opt.integrator;
-  // Photons: photons on surfaces; beams: all beams; hybrid: photons and caustic beams.
+  // Photons: photons on surfaces; beams: all beams; hybrid: photons, caustic beams (with a
+  // scattering medium) and light tracing's share.
   const bool use_photons = kind != IntegratorKind::Beams;
   const bool hybrid = kind == IntegratorKind::Hybrid;
   // The hybrid's caustic beams: none without a scattering medium (they would never be gathered).
@@ -64,9 +65,11 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   PpmSchedule beam_schedule(bd.radius, bd.bandwidth_ps, bd.alpha, bd.beta_t, 1);
   const MediumTracker tracker(scene);
   // Hybrid: light paths splatted from their medium vertices once they have scattered (off a
-  // diffuse surface or in a medium), which camera paths then leave out: one light path per four
-  // pixels per pass (docs/ARCHITECTURE.md, "Path-space partition").
-  const bool light_indirect = hybrid;
+  // diffuse surface or in a medium) or met a surface, and from the diffuse surface vertices the
+  // partition gives them, which camera paths then leave out: one light path per four pixels per
+  // pass (docs/ARCHITECTURE.md, "Path-space partition"). With neither a scattering medium nor a
+  // diffuse surface they would splat nothing.
+  const bool light_indirect = hybrid && (caustic_beams || trace_surface_photons);
   const int64_t indirect_paths = hybrid_light_paths_per_pass(opt, static_cast<int64_t>(W) * H);
   // Photon times include the emission offset: the window end plus the widest pulse spread.
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();
@@ -249,7 +252,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   rep.radius_first = R1;
   rep.bandwidth_first_ps = T1;
   rep.radius_last = state.photon_radius_last;
-  if (hybrid) rep.hybrid_light_paths = indirect_paths;
+  if (light_indirect) rep.hybrid_light_paths = indirect_paths;
   if (caustic_beams) {
     rep.hybrid_beams = true;
     rep.beam_radius_first = bd.radius;

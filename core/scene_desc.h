@@ -155,11 +155,12 @@ struct LightDesc {
 
 /// Which estimators render the image (docs/outputs.md, "Integrators").
 enum class IntegratorKind {
-  Auto,     ///< hybrid (or photons without scattering media) when the scene has delta lights and
-            ///< non-diffuse surfaces, else path
+  Auto,     ///< hybrid (beams when a scattering medium lies behind specular surfaces only) when
+            ///< the scene has delta lights and non-diffuse surfaces, else path
   Path,     ///< camera paths only (volumetric path tracing)
   Light,    ///< light paths connected to the camera (light tracing)
-  Photons,  ///< camera paths + transient progressive photon mapping for caustics on diffuse surfaces
+  Photons,  ///< camera paths + transient progressive photon mapping for caustics on diffuse
+            ///< surfaces
   Beams,    ///< camera paths + transient progressive photon beams for all light scattered in media
   Hybrid    ///< camera paths + photons on surfaces + beams in media, each for caustic paths only
 };

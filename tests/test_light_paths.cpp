@@ -221,6 +221,17 @@ TEST_CASE("the hybrid without a medium agrees with light tracing on a caustic fr
   std::string why;
   CHECK(resolve_integrator(d, IntegratorKind::Auto, why) == IntegratorKind::Hybrid);
   const Scene scene(d);
+  {  // No scattering medium: no caustic beams are traced, light tracing's share is.
+    RenderOptions opt;
+    opt.integrator = IntegratorKind::Hybrid;
+    opt.spp = 2;
+    opt.threads = 2;
+    opt.quiet = true;
+    const RenderResult r = render(scene, opt);
+    CHECK_FALSE(r.photons.hybrid_beams);
+    CHECK(r.photons.seconds_beams == 0);
+    CHECK(r.photons.hybrid_light_paths > 0);
+  }
   const PhotonDesc pd = progressive(4000, 0.5, 1.0);
   const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 1024, 24, 730, pd), 3, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 80000, 24, 830), 3, 2);

@@ -54,8 +54,8 @@ IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, s
   }
   if (!has_scattering_medium(scene)) {
     // Light tracing gives the caustic seen directly exactly, photons the rest: 6x (steady) and
-    // 129x (transient) lower error than photons alone at equal time on a floor caustic
-    // (docs/PERFORMANCE.md, "Without fog").
+    // 129x (transient) lower error than photons alone at equal time on a floor caustic seen
+    // directly (docs/PERFORMANCE.md, "Without fog"; what is seen through glass not measured).
     why =
         "auto: delta lights and non-diffuse surfaces, so caustics come from light tracing where "
         "the camera sees them directly and from photons elsewhere";
@@ -78,8 +78,8 @@ IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, s
   }
   why =
       "auto: delta lights, non-diffuse surfaces and a scattering medium, so caustics come from "
-      "photons on "
-      "surfaces and photon beams in media";
+      "light tracing on the surfaces the camera sees directly, photons on other surfaces and "
+      "photon beams in media";
   return IntegratorKind::Hybrid;
 }
 

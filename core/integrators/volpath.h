@@ -36,9 +36,11 @@ class VolPathIntegrator {
   /// path's first vertex is a medium vertex x_c, only light arriving there directly (next-event
   /// estimation, emission hit) comes from this path: light that scattered or passed a surface
   /// before reaching x_c comes from light tracing (LightTracer::Vertices::MediumIndirect), and
-  /// no caustic beams are gathered on the camera's own segment. When x_c is
-  /// a diffuse surface, light reaching it straight from a medium scattering comes from light
-  /// tracing too: on the segment leaving x_c this path takes no medium light.
+  /// no caustic beams are gathered on the camera's own segment. When x_c is a diffuse surface,
+  /// light tracing gives the light reaching it from a medium scattering (on the segments leaving
+  /// x_c through specular surfaces this path takes no medium light), from a diffuse surface
+  /// through specular ones, and from the light through non-diffuse surfaces only (no photons
+  /// are gathered at x_c).
   void trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats,
              const PhotonGather* photons = nullptr, const BeamGather* beams = nullptr,
              bool light_indirect = false) const;

@@ -119,9 +119,10 @@ std::shared_ptr<RenderOutput> render_py(const py::object& scene, const py::objec
   const CameraDesc& cam = desc.camera;
   const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads_used = opt.threads > 0 ? std::min(opt.threads, hardware) : hardware;
-  const RenderMemory mem = render_memory(cam.width, cam.height, desc.time.bins, opt, threads_used,
-                                         desc.reconstruction.type == TemporalFilter::Kind::Kernel,
-                                         desc.reconstruction.first_pass_spp, false);
+  const RenderMemory mem =
+      render_memory(cam.width, cam.height, desc.time.bins, opt, threads_used,
+                    desc.reconstruction.type == TemporalFilter::Kind::Kernel,
+                    desc.reconstruction.first_pass_spp, false, has_scattering_medium(desc));
   if (mem.peak() > max_memory)
     throw py::value_error(command + ": the render needs " + cli::format_bytes(mem.peak()) +
                           ", more than 75% of this machine's memory (" +
