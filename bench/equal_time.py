@@ -89,7 +89,9 @@ def main():
     work_flag = lambda kind, n: ["--light-paths", n] if kind == "light" else ["--spp", n]
     print(f"equal_time.py: {cpu_model()}, {a.threads} threads, {a.seconds} s per render, {a.seeds} seeds")
     with tempfile.TemporaryDirectory() as tmp:
-        ref_kind, ref_work = a.ref.split(":")
+        ref_kind, _, ref_work = a.ref.partition(":")
+        if not ref_kind or not ref_work:
+            ap.error(f"--ref {a.ref}: expected INTEGRATOR:WORK, e.g. light:6e7")
         t = render(a.femto, a.scene, ["--integrator", ref_kind, "--seed", "1000000"] + work_flag(ref_kind, ref_work) + threads, os.path.join(tmp, "ref"))
         ref, h, w, per_pixel = load(os.path.join(tmp, "ref"))
         mask = [any(ref[p * per_pixel + i] != 0 for i in range(per_pixel)) for p in range(h * w)]

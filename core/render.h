@@ -133,7 +133,7 @@ struct RenderMemory {
 };
 RenderMemory render_memory(int width, int height, int bins, const RenderOptions& options,
                            int threads, bool kernel, int first_pass_spp, bool multipart_frames,
-                           bool scattering_medium = true);
+                           bool scattering_medium);
 
 /// The integrator `kind` stands for in this scene: Auto becomes Hybrid when the scene has delta
 /// lights (point, spot, laser) and non-diffuse surfaces and the film is a histogram (Beams when
