@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <cmath>
@@ -32,9 +33,12 @@ void outward(double lo, double hi, float& flo, float& fhi) {
   fhi = std::nextafter(static_cast<float>(hi + pad), std::numeric_limits<float>::infinity());
 }
 
+/// A piece's box during the build; the items themselves are partitioned (not an index array), so
+/// each node's pieces lie contiguous in memory.
 struct BuildItem {
   float lo[3], hi[3];
   float centre[3];
+  uint32_t piece;  ///< index into the unsorted pieces, also the tie-break of median splits
 };
 
 // Binned surface-area heuristic: camera segments are long and cross the beams' bundles, so the
@@ -70,40 +74,126 @@ struct SahSplit {
   int bin = 0;    ///< bins 0..bin go left
 };
 
-SahSplit sah_split(const std::vector<BuildItem>& items, const uint32_t* order, uint32_t count,
-                   const float clo[3], const float ext[3]) {
+SahSplit sah_split(const BuildItem* items, uint32_t count, const float clo[3], const float ext[3]) {
+  // All three axes binned in one sweep over the node's pieces.
+  Box box[3][kSahBins];
+  uint32_t n[3][kSahBins] = {};
+  float scale[3];
+  for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0 ? kSahBins / ext[a] : 0.0f;
+  for (uint32_t k = 0; k < count; ++k) {
+    const BuildItem& it = items[k];
+    for (int a = 0; a < 3; ++a) {
+      const int b = sah_bin(it.centre[a], clo[a], scale[a]);
+      box[a][b].grow(it.lo, it.hi);
+      ++n[a][b];
+    }
+  }
   SahSplit best;
   double best_cost = std::numeric_limits<double>::infinity();
   for (int a = 0; a < 3; ++a) {
     if (!(ext[a] > 0)) continue;
-    const float scale = kSahBins / ext[a];
-    Box box[kSahBins];
-    uint32_t n[kSahBins] = {};
-    for (uint32_t k = 0; k < count; ++k) {
-      const BuildItem& it = items[order[k]];
-      const int b = sah_bin(it.centre[a], clo[a], scale);
-      box[b].grow(it.lo, it.hi);
-      ++n[b];
-    }
     double right_cost[kSahBins];  // area x count of bins b + 1 .. end
     Box acc;
     uint32_t acc_n = 0;
     for (int b = kSahBins - 1; b > 0; --b) {
-      acc.grow(box[b].lo, box[b].hi);
-      acc_n += n[b];
+      acc.grow(box[a][b].lo, box[a][b].hi);
+      acc_n += n[a][b];
       right_cost[b - 1] = acc_n > 0 ? acc.half_area() * acc_n : 0.0;
     }
     Box left;
     uint32_t left_n = 0;
     for (int b = 0; b + 1 < kSahBins; ++b) {
-      left.grow(box[b].lo, box[b].hi);
-      left_n += n[b];
+      left.grow(box[a][b].lo, box[a][b].hi);
+      left_n += n[a][b];
       if (left_n == 0 || left_n == count) continue;
       const double cost = left.half_area() * left_n + right_cost[b];
       if (cost < best_cost) best_cost = cost, best.axis = a, best.bin = b;
     }
   }
   return best;
+}
+}  // namespace
+
+namespace {
+// Subtrees of at least this many pieces build their two halves in parallel (into their own node
+// arrays, spliced after): the logical tree, and so every query's order, is that of a serial build.
+constexpr uint32_t kParallelCount = 16384;
+
+/// Builds the subtree of items [first, first + count) with its root at nodes[at] (BeamBvh's
+/// node type is private: deduced here).
+template <class Node>
+void build_subtree(BuildItem* items, uint32_t first, uint32_t count, uint32_t depth,
+                   std::vector<Node>& nodes, uint32_t at) {
+  BuildItem* begin = items + first;
+  float blo[3], bhi[3], clo[3], chi[3];
+  for (int c = 0; c < 3; ++c) {
+    blo[c] = clo[c] = std::numeric_limits<float>::infinity();
+    bhi[c] = chi[c] = -std::numeric_limits<float>::infinity();
+  }
+  for (uint32_t i = 0; i < count; ++i) {
+    const BuildItem& it = begin[i];
+    for (int c = 0; c < 3; ++c) {
+      blo[c] = std::min(blo[c], it.lo[c]);
+      bhi[c] = std::max(bhi[c], it.hi[c]);
+      clo[c] = std::min(clo[c], it.centre[c]);
+      chi[c] = std::max(chi[c], it.centre[c]);
+    }
+  }
+  for (int c = 0; c < 3; ++c) nodes[at].lo[c] = blo[c], nodes[at].hi[c] = bhi[c];
+  const float ext[3] = {chi[0] - clo[0], chi[1] - clo[1], chi[2] - clo[2]};
+  const int widest = ext[0] >= ext[1] && ext[0] >= ext[2] ? 0 : (ext[1] >= ext[2] ? 1 : 2);
+  if (count <= kLeafSize || !(ext[widest] > 0)) {
+    nodes[at].first = first;
+    nodes[at].count = count;
+    return;
+  }
+  // Below kSahDepth median splits only: the depth stays within the query's stack.
+  const SahSplit split =
+      depth < kSahDepth && count > kSahMinCount ? sah_split(begin, count, clo, ext) : SahSplit{};
+  uint32_t half;
+  if (split.axis >= 0) {
+    // Pieces whose centre falls in bins 0..split.bin go left (a deterministic partition).
+    const int a = split.axis;
+    const float scale = kSahBins / ext[a];
+    BuildItem* mid = std::partition(begin, begin + count, [&](const BuildItem& it) {
+      return sah_bin(it.centre[a], clo[a], scale) <= split.bin;
+    });
+    half = static_cast<uint32_t>(mid - begin);
+  } else {  // no bin boundary separates the centres: split at the median of the widest axis
+    half = count / 2;
+    std::nth_element(begin, begin + half, begin + count,
+                     [&](const BuildItem& a, const BuildItem& b) {
+                       const float ca = a.centre[widest], cb = b.centre[widest];
+                       return ca < cb || (ca == cb && a.piece < b.piece);
+                     });
+  }
+  const auto left = static_cast<uint32_t>(nodes.size());
+  nodes[at].first = left;
+  nodes.push_back({});
+  nodes.push_back({});
+  if (count < kParallelCount) {
+    build_subtree(items, first, half, depth + 1, nodes, left);
+    build_subtree(items, first + half, count - half, depth + 1, nodes, left + 1);
+    return;
+  }
+  std::vector<Node> sub[2];
+  sub[0].reserve(2 * half);  // a binary tree over n pieces has fewer than 2 n nodes
+  sub[1].reserve(2 * (count - half));
+  for (auto& v : sub) v.push_back({});
+  tbb::parallel_invoke(
+      [&] { build_subtree(items, first, half, depth + 1, sub[0], 0); },
+      [&] { build_subtree(items, first + half, count - half, depth + 1, sub[1], 0); });
+  // Each subtree's root goes to its slot beside its sibling, its other nodes after the array's
+  // end; inner nodes' child indices move with them (leaves index pieces, which stay).
+  for (int k = 0; k < 2; ++k) {
+    const auto base = static_cast<uint32_t>(nodes.size()) - 1;  // local index i >= 1 -> base + i
+    auto moved = [&](Node n) {
+      if (n.count == 0) n.first += base;
+      return n;
+    };
+    nodes[left + static_cast<uint32_t>(k)] = moved(sub[k][0]);
+    for (size_t i = 1; i < sub[k].size(); ++i) nodes.push_back(moved(sub[k][i]));
+  }
 }
 }  // namespace
 
@@ -126,6 +216,7 @@ void BeamBvh::build(std::vector<Beam> beams, double radius) {
       const Vec3 a = b.o + b.d * a_v, e = b.o + b.d * b_v;
       const Vec3 lo = vmin(a, e) - Vec3(radius), hi = vmax(a, e) + Vec3(radius);
       BuildItem it;
+      it.piece = static_cast<uint32_t>(pieces_.size());
       outward(lo.x, hi.x, it.lo[0], it.hi[0]);
       outward(lo.y, hi.y, it.lo[1], it.hi[1]);
       outward(lo.z, hi.z, it.lo[2], it.hi[2]);
@@ -136,74 +227,13 @@ void BeamBvh::build(std::vector<Beam> beams, double radius) {
     }
   }
   // Splits by the binned surface-area heuristic (median splits of the widest axis of the centres
-  // in small nodes, deep in the tree and where it finds none), over an index permutation: the
-  // same tree on every run. A node's children are adjacent.
-  std::vector<uint32_t> order(pieces_.size());
-  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  // in small nodes, deep in the tree and where it finds none), partitioning the items in place:
+  // the same tree on every run and for any thread count. A node's children are adjacent.
   nodes_.reserve(2 * pieces_.size() / kLeafSize + 2);
-  struct Task {
-    uint32_t first, count, node, depth;
-  };
-  std::vector<Task> todo;
   nodes_.push_back({});
-  todo.push_back({0, static_cast<uint32_t>(order.size()), 0, 0});
-  while (!todo.empty()) {
-    const Task t = todo.back();
-    todo.pop_back();
-    float blo[3], bhi[3], clo[3], chi[3];
-    for (int c = 0; c < 3; ++c) {
-      blo[c] = clo[c] = std::numeric_limits<float>::infinity();
-      bhi[c] = chi[c] = -std::numeric_limits<float>::infinity();
-    }
-    for (uint32_t i = t.first; i < t.first + t.count; ++i) {
-      const BuildItem& it = items[order[i]];
-      for (int c = 0; c < 3; ++c) {
-        blo[c] = std::min(blo[c], it.lo[c]);
-        bhi[c] = std::max(bhi[c], it.hi[c]);
-        clo[c] = std::min(clo[c], it.centre[c]);
-        chi[c] = std::max(chi[c], it.centre[c]);
-      }
-    }
-    Node& node = nodes_[t.node];
-    for (int c = 0; c < 3; ++c) node.lo[c] = blo[c], node.hi[c] = bhi[c];
-    const float ext[3] = {chi[0] - clo[0], chi[1] - clo[1], chi[2] - clo[2]};
-    const int widest = ext[0] >= ext[1] && ext[0] >= ext[2] ? 0 : (ext[1] >= ext[2] ? 1 : 2);
-    if (t.count <= kLeafSize || !(ext[widest] > 0)) {
-      node.first = t.first;
-      node.count = t.count;
-      continue;
-    }
-    // Below kSahDepth median splits only: the depth stays within the query's stack.
-    const SahSplit split = t.depth < kSahDepth && t.count > kSahMinCount
-                               ? sah_split(items, order.data() + t.first, t.count, clo, ext)
-                               : SahSplit{};
-    uint32_t half;
-    if (split.axis >= 0) {
-      // Pieces whose centre falls in bins 0..split.bin go left (a deterministic partition).
-      const int a = split.axis;
-      const float scale = kSahBins / ext[a];
-      auto* first = order.data() + t.first;
-      auto* mid = std::partition(first, first + t.count, [&](uint32_t i) {
-        return sah_bin(items[i].centre[a], clo[a], scale) <= split.bin;
-      });
-      half = static_cast<uint32_t>(mid - first);
-    } else {  // no bin boundary separates the centres: split at the median of the widest axis
-      half = t.count / 2;
-      std::nth_element(order.begin() + t.first, order.begin() + t.first + half,
-                       order.begin() + t.first + t.count, [&](uint32_t a, uint32_t b) {
-                         const float ca = items[a].centre[widest], cb = items[b].centre[widest];
-                         return ca < cb || (ca == cb && a < b);
-                       });
-    }
-    const auto left = static_cast<uint32_t>(nodes_.size()), right = left + 1;
-    nodes_.push_back({});
-    nodes_.push_back({});
-    nodes_[t.node].first = left;
-    todo.push_back({t.first + half, t.count - half, right, t.depth + 1});
-    todo.push_back({t.first, half, left, t.depth + 1});
-  }
+  build_subtree(items.data(), 0, static_cast<uint32_t>(items.size()), 0, nodes_, 0);
   std::vector<Piece> sorted(pieces_.size());
-  for (size_t i = 0; i < order.size(); ++i) sorted[i] = pieces_[order[i]];
+  for (size_t i = 0; i < items.size(); ++i) sorted[i] = pieces_[items[i].piece];
   pieces_ = std::move(sorted);
 }
 
