@@ -29,7 +29,7 @@ TEST_CASE("path-only and hybrid agree for an emissive sphere above glass in fog"
       { "type": "sphere", "center": [-15, 70, 0], "radius": 5, "emission": 30,
         "material": { "type": "diffuse", "albedo": 0 } })");
   const Scene scene(d);
-  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
+  const PhotonDesc pd = progressive(10000, 0.8, 1.0);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 192, 24, 800), 4, 2);
   const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 64, 24, 900, pd), 4, 2);
   require_agreement(pt, hy, 12, 0.025);  // a 10% error would be 4 standard errors
@@ -70,7 +70,7 @@ TEST_CASE("path-only and hybrid agree on fog and ceiling light refracted onto th
   })",
                                         "fog above a hole", ".");
   const Scene scene(d);
-  const PhotonDesc pd = progressive(20000, 0.8, 1.0);
+  const PhotonDesc pd = progressive(10000, 0.8, 1.0);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 512, 24, 1200), 4, 2);
   const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 96, 24, 1300, pd), 4, 2);
   require_agreement(pt, hy, 8, 0.08);  // a 32% error would be 4 standard errors

@@ -57,7 +57,7 @@ SceneDesc fog_box(int w, int h) {
 TEST_CASE("photon beams agree with camera paths in a fog box, bin by bin", "[beams][statistical]") {
   const Scene scene(fog_box(16, 12));
   // Radius small against the 4 x 4 pixel blocks compared: kernel bias far below the noise.
-  const PhotonDesc pd = progressive(4000, 0.5, 1.0);
+  const PhotonDesc pd = progressive(4000, 1.0, 1.0);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 128, 24, 100), 4, 3);
   const auto bm = cells(batches(scene, IntegratorKind::Beams, 16, 24, 200, pd), 4, 3);
   require_agreement(pt, bm, 15);
@@ -204,7 +204,7 @@ TEST_CASE("photon beams agree with camera paths in a voxel medium with per-voxel
   d.time.bin_width_ps = 100;
   d.time.bins = 10;
   const Scene scene(d);
-  const PhotonDesc pd = progressive(4000, 0.5, 1.0);
+  const PhotonDesc pd = progressive(4000, 1.0, 1.0);
   const auto pt = cells(batches(scene, IntegratorKind::Path, 96, 16, 600), 4, 2);
   const auto bm = cells(batches(scene, IntegratorKind::Beams, 16, 16, 700, pd), 4, 2);
   require_agreement(pt, bm, 10);
