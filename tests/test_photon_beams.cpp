@@ -269,8 +269,8 @@ TEST_CASE("the beam tree finds every beam a camera segment passes within R of", 
   BeamBvh bvh;
   bvh.build(beams, R);
   CHECK(bvh.size() == beams.size());
-  // Enough pieces (about 54000) that the halves of the top two levels build in parallel and are
-  // spliced (at 16384 pieces or more).
+  // Enough pieces (about 54000) that at least the root's halves build in parallel and the right
+  // one is spliced (at 16384 pieces or more).
   CHECK(bvh.pieces() > 2 * 16384);
   size_t found_total = 0;
   for (int q = 0; q < 2000; ++q) {

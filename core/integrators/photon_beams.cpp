@@ -83,6 +83,7 @@ SahSplit sah_split(const BuildItem* items, uint32_t count, const float clo[3], c
   for (uint32_t k = 0; k < count; ++k) {
     const BuildItem& it = items[k];
     for (int a = 0; a < 3; ++a) {
+      if (!(ext[a] > 0)) continue;  // a flat axis has no split (and inf * 0 would be NaN)
       const int b = sah_bin(it.centre[a], clo[a], scale[a]);
       box[a][b].grow(it.lo, it.hi);
       ++n[a][b];
@@ -115,8 +116,8 @@ SahSplit sah_split(const BuildItem* items, uint32_t count, const float clo[3], c
 }  // namespace
 
 namespace {
-// Subtrees of at least this many pieces build their two halves in parallel (into their own node
-// arrays, spliced after): the logical tree, and so every query's order, is that of a serial build.
+// Subtrees of at least this many pieces build their two halves in parallel: the node array, and
+// so every query's order, is that of a serial build.
 constexpr uint32_t kParallelCount = 16384;
 
 /// Builds the subtree of items [first, first + count) with its root at nodes[at] (BeamBvh's
@@ -176,24 +177,20 @@ void build_subtree(BuildItem* items, uint32_t first, uint32_t count, uint32_t de
     build_subtree(items, first + half, count - half, depth + 1, nodes, left + 1);
     return;
   }
-  std::vector<Node> sub[2];
-  sub[0].reserve(2 * half);  // a binary tree over n pieces has fewer than 2 n nodes
-  sub[1].reserve(2 * (count - half));
-  for (auto& v : sub) v.push_back({});
+  // The left half builds in place (the only writer of `nodes` meanwhile), the right half into
+  // its own array, spliced after: its root into the slot beside its sibling, its other nodes at
+  // the end, inner nodes' child indices moved with them (leaves index pieces, which stay).
+  std::vector<Node> right(1);
   tbb::parallel_invoke(
-      [&] { build_subtree(items, first, half, depth + 1, sub[0], 0); },
-      [&] { build_subtree(items, first + half, count - half, depth + 1, sub[1], 0); });
-  // Each subtree's root goes to its slot beside its sibling, its other nodes after the array's
-  // end; inner nodes' child indices move with them (leaves index pieces, which stay).
-  for (int k = 0; k < 2; ++k) {
-    const auto base = static_cast<uint32_t>(nodes.size()) - 1;  // local index i >= 1 -> base + i
-    auto moved = [&](Node n) {
-      if (n.count == 0) n.first += base;
-      return n;
-    };
-    nodes[left + static_cast<uint32_t>(k)] = moved(sub[k][0]);
-    for (size_t i = 1; i < sub[k].size(); ++i) nodes.push_back(moved(sub[k][i]));
-  }
+      [&] { build_subtree(items, first, half, depth + 1, nodes, left); },
+      [&] { build_subtree(items, first + half, count - half, depth + 1, right, 0); });
+  const auto base = static_cast<uint32_t>(nodes.size()) - 1;  // local index i >= 1 -> base + i
+  auto moved = [&](Node n) {
+    if (n.count == 0) n.first += base;
+    return n;
+  };
+  nodes[left + 1] = moved(right[0]);
+  for (size_t i = 1; i < right.size(); ++i) nodes.push_back(moved(right[i]));
 }
 }  // namespace
 

@@ -105,9 +105,10 @@ std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64
                               const distributed::Comm* comm = nullptr);
 
 /// Memory of one pass holding `beams` beams: the traced lists and the tree's copy, and at most
-/// kMaxPieces pieces per beam with their build boxes and nodes.
+/// kMaxPieces pieces per beam with their build boxes and nodes (40 + 32 bytes a piece, and up to
+/// half the nodes again, with growth, in the right halves built in parallel).
 inline uint64_t beam_pass_bytes(uint64_t beams) {
-  return beams * (3 * sizeof(Beam) + BeamBvh::kMaxPieces * (sizeof(BeamBvh::Piece) + 64));
+  return beams * (3 * sizeof(Beam) + BeamBvh::kMaxPieces * (sizeof(BeamBvh::Piece) + 104));
 }
 
 template <class F>
