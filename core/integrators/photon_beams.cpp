@@ -113,9 +113,7 @@ SahSplit sah_split(const BuildItem* items, uint32_t count, const float clo[3], c
   }
   return best;
 }
-}  // namespace
 
-namespace {
 // Subtrees of at least this many pieces build their two halves in parallel: the node array, and
 // so every query's order, is that of a serial build.
 constexpr uint32_t kParallelCount = 16384;
