@@ -23,6 +23,7 @@ const char* RenderOverrides::camera_only_flag() const {
          : light_paths          ? "--light-paths"
          : photon_radius        ? "--photon-radius"
          : photon_bandwidth     ? "--photon-bandwidth"
+         : photon_aim           ? "--photon-aim"
                                 : nullptr;
 }
 
@@ -155,6 +156,11 @@ bool parse_render_flag(cli::Args& args, const std::string& a, RenderOverrides& o
   } else if (a == "--photon-bandwidth") {
     o.photon_bandwidth = args.number_in(0.0, 1e12, true, false, "in (0, 1e12] ps");
     if (o.photon_flag.empty()) o.photon_flag = a;
+  } else if (a == "--photon-aim") {
+    const std::string v = args.value();
+    if (v != "on" && v != "off") args.fail("expected on or off", v);
+    o.photon_aim = v == "on";
+    if (o.photon_flag.empty()) o.photon_flag = a;
   } else if (a == "--max-depth") {
     o.max_depth = static_cast<int>(args.int_value(1, 1000000));
   } else if (a == "--russian-roulette") {
@@ -191,6 +197,7 @@ RenderSetup apply_render_overrides(SceneDesc& desc, const RenderOverrides& o,
   if (o.photons_per_pass) pd.per_pass = *o.photons_per_pass;
   if (o.photon_radius) pd.radius = *o.photon_radius;
   if (o.photon_bandwidth) pd.bandwidth_ps = *o.photon_bandwidth;
+  if (o.photon_aim) pd.aim = *o.photon_aim;
   std::string integrator_why;
   const IntegratorKind kind = resolve_integrator(desc, desc.integrator.kind, integrator_why);
   if (kind != IntegratorKind::Path && rec.type == TemporalFilter::Kind::Kernel)

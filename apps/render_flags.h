@@ -30,6 +30,7 @@ struct RenderOverrides {
   std::optional<int64_t> light_paths, photons_per_pass;
   std::optional<double> camera_ball;
   std::optional<double> photon_radius, photon_bandwidth;
+  std::optional<bool> photon_aim;
   std::string kernel_flag;  ///< the first kernel-only flag given, for the error message
   std::string photon_flag;  ///< the first photon-only flag given, for the error message
 

@@ -110,6 +110,15 @@ nlohmann::json integrator_json(IntegratorKind kind, const std::string& why,
                               "T_j ((j + alpha) / (j + 1))^beta_t";
       j[beams ? "max_beams_stored_per_pass" : "max_photons_stored_per_pass"] =
           p.max_stored_per_pass;
+      if (!beams || p.hybrid_beams) {
+        nlohmann::json lights = nlohmann::json::array();
+        for (double share : p.aim_share)
+          lights.push_back(share < 0
+                               ? nlohmann::json{{"aimed", false}}
+                               : nlohmann::json{{"aimed", true}, {"solid_angle_share", share}});
+        j["aim"] = {
+            {"enabled", p.aim}, {"lights", lights}, {"paths_per_pass_scale", p.aim_paths_scale}};
+      }
       if (p.hybrid_beams)
         j["caustic_beams"] = {
             {"description",
@@ -192,7 +201,8 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
                                              {"bandwidth_ps", pd.bandwidth_ps},
                                              {"alpha", pd.alpha},
                                              {"beta_t", pd.beta_t},
-                                             {"kernel", static_cast<int>(pd.kernel)}}},
+                                             {"kernel", static_cast<int>(pd.kernel)},
+                                             {"aim", pd.aim}}},
             {"reconstruction",
              {{"type", r.type == TemporalFilter::Kind::Kernel ? "kernel" : "histogram"},
               {"kernel", static_cast<int>(r.kernel)},

@@ -80,7 +80,8 @@ def main():
     ap.add_argument("scene")
     ap.add_argument("--femto", default="build/femto")
     ap.add_argument("--ref", default="light:6e7", help="INTEGRATOR:WORK (light paths for light, else passes)")
-    ap.add_argument("--integrators", default="photons,hybrid")
+    ap.add_argument("--integrators", default="photons,hybrid",
+                    help='comma-separated; an entry may carry flags: "hybrid --photon-aim off"')
     ap.add_argument("--seconds", type=float, default=8.0)
     ap.add_argument("--seeds", type=int, default=6)
     ap.add_argument("--threads", type=int, default=2)
@@ -97,13 +98,14 @@ def main():
         mask = [any(ref[p * per_pixel + i] != 0 for i in range(per_pixel)) for p in range(h * w)]
         print(f"reference: {a.ref}, {t:.1f} s; {sum(mask)} of {h * w} pixels with light")
         first = None
-        for kind in a.integrators.split(","):
-            out = os.path.join(tmp, kind)
-            t = render(a.femto, a.scene, ["--integrator", kind, "--seed", "1"] + work_flag(kind, "8") + threads, out)
+        for entry in a.integrators.split(","):
+            kind, *extra = entry.split()  # "hybrid --photon-aim off": an integrator and its flags
+            out = os.path.join(tmp, "run")
+            t = render(a.femto, a.scene, ["--integrator", kind, "--seed", "1"] + work_flag(kind, "8") + extra + threads, out)
             work = max(1, int(8 * a.seconds / t))
             seconds, steady, transient = [], [], []
             for seed in range(1, a.seeds + 1):
-                seconds.append(render(a.femto, a.scene, ["--integrator", kind, "--seed", str(seed)] + work_flag(kind, str(work)) + threads, out))
+                seconds.append(render(a.femto, a.scene, ["--integrator", kind, "--seed", str(seed)] + work_flag(kind, str(work)) + extra + threads, out))
                 v, _, _, _ = load(out)
                 e_s, e_t = errors(v, ref, mask, per_pixel)
                 steady.append(e_s)
@@ -111,7 +113,7 @@ def main():
             rms = lambda e: math.sqrt(sum(x * x for x in e) / len(e))
             row = (statistics.median(steady), statistics.median(transient), rms(steady), rms(transient))
             first = first or row
-            print(f"{kind:8s} work {work:8d}  {statistics.mean(seconds):5.2f} s  median steady {row[0]:.4f} "
+            print(f"{entry:8s} work {work:8d}  {statistics.mean(seconds):5.2f} s  median steady {row[0]:.4f} "
                   f"({first[0] / row[0]:.2f}x), transient {row[1]:.4f} ({first[1] / row[1]:.2f}x)  "
                   f"RMS steady {row[2]:.4f}, transient {row[3]:.4f}")
     return 0

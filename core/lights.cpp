@@ -17,6 +17,10 @@ double smoothstep(double a, double b, double x) {
 }
 }  // namespace
 
+double spot_falloff(const Light& l, double cos_t) {
+  return smoothstep(l.cos_cone, l.cos_falloff, cos_t);
+}
+
 LightSet::LightSet(const SceneDesc& scene) : scene_(&scene) {
   shape_light_.assign(scene.shapes.size(), -1);
   std::vector<double> power;

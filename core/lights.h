@@ -39,6 +39,10 @@ struct Light {
   PulseDesc pulse;
 };
 
+/// A spot's smooth falloff at cosine cos_t from its axis: 0 outside the cone, 1 inside the
+/// falloff start.
+double spot_falloff(const Light& l, double cos_t);
+
 /// Point and spot lights: a single emitting point, the target of segment connections.
 inline bool is_point_like(const Light& l) {
   return l.type == Light::Type::Point || l.type == Light::Type::Spot;

@@ -94,6 +94,12 @@ struct RenderResult {
     double beam_alpha = 0, beam_beta_t = 0;
     int64_t beam_paths = 0;
     int64_t hybrid_light_paths = 0;  ///< hybrid: light paths per pass for light tracing's share
+    /// Photons and caustic beams: whether /render/photons/aim was on for paths that could use it,
+    /// and per light the aimed cones' share of its emission (-1: not aimed;
+    /// core/transport/caustic_aim.h).
+    bool aim = false;
+    std::vector<double> aim_share;
+    double aim_paths_scale = 1;  ///< default paths per pass multiplied by this (aimed, unset)
     /// Hybrid, camera in a scattering medium: the camera ball (core/integrators/camera_ball.h),
     /// its gather kernel's slope and smallest radius at the first and after the last pass, and
     /// the most beams one pass kept in it.

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "core/distributed/render_gather.h"
 #include "core/integrators/camera_ball.h"
@@ -28,6 +29,8 @@ using passes::kTile;
 constexpr int64_t kIndirectChunk = 1024;  // indirect-light paths per task (deterministic order)
 /// Indirect-light streams are keyed apart from camera pixels, photons and beams.
 constexpr uint64_t kIndirectStream = 0x7000000000000000ULL;
+/// Fewest aimed photon or caustic beam paths a pass emits by default.
+constexpr int64_t kMinAimedPaths = 100;
 }
 
 RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
@@ -54,11 +57,26 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   PhotonDesc photon_opts = opt.photons;
   if (hybrid && photon_opts.per_pass <= 0)
     photon_opts.per_pass = default_hybrid_photons_per_pass(static_cast<int64_t>(W) * H);
-  const PhotonDesc pd = progressive_settings(
+  PhotonDesc pd = progressive_settings(
       scene, kind == IntegratorKind::Beams ? IntegratorKind::Beams : IntegratorKind::Photons,
       photon_opts);
-  const PhotonDesc bd = progressive_settings(
+  PhotonDesc bd = progressive_settings(
       scene, caustic_beams ? IntegratorKind::Hybrid : IntegratorKind::Beams, opt.photons);
+  // Aimed photons and caustic beams (core/transport/caustic_aim.h). Unless per_pass was chosen,
+  // a pass emits the default count times the share of plain emission that aiming keeps: as many
+  // photons and beams stored as plain emission gave, without tracing the paths that stored
+  // nothing. (Aimed at the default count, a point light beside a small glass sphere stored 70x
+  // more at 4x the cost of those parts, and lost at equal time: docs/PERFORMANCE.md.)
+  const CausticAim aim = opt.photons.aim ? CausticAim(scene.desc(), scene.lights()) : CausticAim{};
+  const bool aimed = aim.any() && (trace_surface_photons || caustic_beams);
+  const double aim_share = aimed ? aim.path_share(scene.lights()) : 1.0;
+  if (aimed && opt.photons.per_pass <= 0) {
+    auto scaled = [&](int64_t n) {
+      return std::max<int64_t>(kMinAimedPaths, std::llround(static_cast<double>(n) * aim_share));
+    };
+    if (trace_surface_photons) pd.per_pass = scaled(pd.per_pass);
+    if (caustic_beams) bd.per_pass = scaled(bd.per_pass);
+  }
   const double R1 = use_photons ? pd.radius : bd.radius,
                T1 = use_photons ? pd.bandwidth_ps : bd.bandwidth_ps;
   PpmSchedule schedule(pd.radius, pd.bandwidth_ps, pd.alpha, pd.beta_t, use_photons ? 2 : 1);
@@ -126,8 +144,9 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       auto part_start = pass_start;
       if (use_beams) {
         const int64_t paths = bd.per_pass;
-        std::vector<Beam> beams = trace_beams(scene, opt.seed, pass, paths, opt.max_depth,
-                                              photon_t_cut, photon_stats, caustic_beams, opt.comm);
+        std::vector<Beam> beams =
+            trace_beams(scene, opt.seed, pass, paths, opt.max_depth, photon_t_cut, photon_stats,
+                        caustic_beams, opt.comm, &aim);
         state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, beams.size());
         bvh.build(std::move(beams), beam_schedule.radius());
         pass_bytes += bvh.memory_bytes();
@@ -142,8 +161,9 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
         seconds_beams += since(part_start);
       }
       if (trace_surface_photons) {
-        std::vector<Photon> photons = trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth,
-                                                    photon_t_cut, photon_stats, opt.comm);
+        std::vector<Photon> photons =
+            trace_photons(scene, opt.seed, pass, pd.per_pass, opt.max_depth, photon_t_cut,
+                          photon_stats, opt.comm, &aim);
         state.photon_max_stored = std::max<uint64_t>(state.photon_max_stored, photons.size());
         grid.build(std::move(photons), schedule.radius());
         pass_bytes += grid.memory_bytes();
@@ -253,6 +273,11 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   rep.bandwidth_first_ps = T1;
   rep.radius_last = state.photon_radius_last;
   if (light_indirect) rep.hybrid_light_paths = indirect_paths;
+  rep.aim = aimed;
+  rep.aim_paths_scale = aimed && opt.photons.per_pass <= 0 ? aim_share : 1.0;
+  if (opt.photons.aim && (trace_surface_photons || caustic_beams))
+    for (int i = 0; i < scene.lights().count(); ++i)
+      rep.aim_share.push_back(aim.aims(i) ? aim.solid_angle_ratio(i) : -1.0);
   if (caustic_beams) {
     rep.hybrid_beams = true;
     rep.beam_radius_first = bd.radius;

@@ -175,6 +175,9 @@ struct PhotonDesc {
   double alpha = 0.0;            ///< kernel volume ratio per pass, (j + alpha) / (j + 1)
   double beta_t = -1.0;          ///< share of the shrinkage given to time (R^dims takes 1 - beta_t)
   TemporalKernel kernel = TemporalKernel::Epanechnikov;
+  /// Photons and caustic beams: point and spot lights emit towards the non-diffuse shapes only
+  /// (core/transport/caustic_aim.h).
+  bool aim = true;
 };
 
 /// Russian roulette on camera paths (docs/scene-format.md, "render"): after the scattering or

@@ -615,8 +615,15 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     CHECK(cli_contains(integ["why"].get<std::string>(), cases[i].why_part));
     if (cases[i].type == "photons" || cases[i].type == "hybrid") {
       CHECK(integ["passes"] == 2);
-      // The hybrid's default is one photon per two pixels, at least 10000 (40 x 24 pixels here).
-      CHECK(integ["photons_per_pass"].get<int64_t>() == (cases[i].flags.empty() ? 10000 : 3000));
+      // The hybrid's default is one photon per two pixels, at least 10000 (40 x 24 pixels here),
+      // times the share of the light's emission aimed at the glass (docs/outputs.md); a chosen
+      // count stays as it is.
+      const double scale = integ["aim"]["paths_per_pass_scale"].get<double>();
+      CHECK(scale == (cases[i].flags.empty()
+                          ? integ["aim"]["lights"][0]["solid_angle_share"].get<double>()
+                          : 1.0));
+      CHECK(integ["photons_per_pass"].get<int64_t>() ==
+            (cases[i].flags.empty() ? std::max<int64_t>(100, std::llround(10000 * scale)) : 3000));
       CHECK(integ["photon_memory_bytes_peak"].get<uint64_t>() > 0);
       if (!cases[i].flags.empty()) {
         CHECK(integ["radius_mm"]["first_pass"].get<double>() == 2.0);
@@ -631,8 +638,11 @@ TEST_CASE("cli: --integrator choices are recorded in render.json", "[cli]") {
     if (cases[i].type == "light") CHECK(integ["light_paths"] == 20000);
     if (cases[i].type == "hybrid") {
       CHECK(integ["caustic_beams"]["alpha"].get<double>() == Approx(2.0 / 3.0));
-      // One beam path per 128 pixels of the 40 x 24 film, raised to the floor of 500.
-      CHECK(integ["caustic_beams"]["light_paths_per_pass"] == 500);
+      // One beam path per 128 pixels of the 40 x 24 film, raised to the floor of 500, times the
+      // aimed share, raised to 100.
+      CHECK(integ["caustic_beams"]["light_paths_per_pass"] ==
+            std::max<int64_t>(
+                100, std::llround(500 * integ["aim"]["paths_per_pass_scale"].get<double>())));
     }
     if (cases[i].type != "path" && cases[i].type != "light") {
       // Each part of a pass is timed where it runs (none where it does not), within the render.

@@ -64,7 +64,7 @@ TEST_CASE("hybrid agrees with light tracing on a volumetric caustic from a point
           "[hybrid][beams][statistical]") {
   const SceneDesc d =
       glass_in_fog(R"({ "type": "point", "position": [-30, 80, 0], "intensity": 3000 })", "");
-  hybrid_matches_light_tracing(Scene(d), {-5, 35, 0}, 1000, 1100, 10000);
+  hybrid_matches_light_tracing(Scene(d), {-5, 35, 0}, 1000, 1100, 1000);
 }
 
 // Catches: the light's own caustic on the floor seen directly (light -> glass or rough metal ->

@@ -205,7 +205,7 @@ TEST_CASE("light tracing agrees with camera paths in a voxel medium with per-vox
 TEST_CASE("camera paths + photons agree with light tracing on a caustic from a point light",
           "[light-paths][statistical]") {
   const Scene scene(caustic_scene(axis_of(250, 60, 8)));
-  const PhotonDesc pd = progressive(40000, 0.5, 1.0);
+  const PhotonDesc pd = progressive(4000, 0.5, 1.0);
   const auto ph = cells(batches(scene, IntegratorKind::Photons, 16, 24, 700, pd), 3, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 40000, 24, 800), 3, 2);
   require_agreement(ph, lt, 10);
@@ -232,7 +232,7 @@ TEST_CASE("the hybrid without a medium agrees with light tracing on a caustic fr
     CHECK(r.photons.seconds_beams == 0);
     CHECK(r.photons.hybrid_light_paths > 0);
   }
-  const PhotonDesc pd = progressive(4000, 0.5, 1.0);
+  const PhotonDesc pd = progressive(400, 0.5, 1.0);
   const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 1024, 24, 730, pd), 3, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 80000, 24, 830), 3, 2);
   require_agreement(hy, lt, 10);

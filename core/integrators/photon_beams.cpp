@@ -282,7 +282,7 @@ void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, do
 
 std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64_t count,
                               int max_depth, double t_cut_ps, PathStats& stats, bool caustic_only,
-                              const distributed::Comm* comm) {
+                              const distributed::Comm* comm, const CausticAim* aim) {
   const MediumTracker tracker(scene);
   return trace_in_chunks<Beam>(
       count, kBeamChunk, stats,
@@ -305,7 +305,7 @@ std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64
               }
               return true;
             },
-            /*segments=*/true);
+            /*segments=*/true, /*rays=*/false, caustic_only ? aim : nullptr);
       },
       comm);
 }

@@ -14,6 +14,7 @@
 #include "core/pixel_accumulator.h"
 #include "core/scene.h"
 #include "core/temporal_filter.h"
+#include "core/transport/caustic_aim.h"
 #include "core/transport/tracker.h"
 
 namespace femto {
@@ -98,11 +99,12 @@ struct BeamGather {
 
 /// Traces `count` light paths of one pass and returns their beams in path order (the same list
 /// for any thread count). `caustic_only`: only segments that follow one or more non-diffuse
-/// surfaces with no medium or diffuse scattering before them (light -> (S|G)+ -> medium).
+/// surfaces with no medium or diffuse scattering before them (light -> (S|G)+ -> medium); only
+/// then may `aim` aim the lights' emission at those surfaces (core/transport/caustic_aim.h).
 std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64_t count,
                               int max_depth, double t_cut_ps, PathStats& stats,
-                              bool caustic_only = false,
-                              const distributed::Comm* comm = nullptr);
+                              bool caustic_only = false, const distributed::Comm* comm = nullptr,
+                              const CausticAim* aim = nullptr);
 
 /// Memory of one pass holding `beams` beams: the traced lists and the tree's copy, and at most
 /// kMaxPieces pieces per beam with their build boxes and nodes (40 + 32 bytes a piece, and up to

@@ -79,22 +79,25 @@ void PhotonGather::gather(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& 
 
 std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count,
                                   int max_depth, double t_cut_ps, PathStats& stats,
-                                  const distributed::Comm* comm) {
+                                  const distributed::Comm* comm, const CausticAim* aim) {
   const MediumTracker tracker(scene);
   return trace_in_chunks<Photon>(
       count, kPhotonChunk, stats,
       [&](int64_t i, std::vector<Photon>& out, PathStats& st) {
         Rng rng = Rng::for_sample(seed, kPhotonStream + static_cast<uint64_t>(pass),
                                   static_cast<uint64_t>(i));
-        walk_light_path(scene, tracker, rng, max_depth, t_cut_ps, st, [&](const LightVertex& v) {
-          if (v.kind != LightVertex::Kind::Surface) return v.kind == LightVertex::Kind::Emitter;
-          if (!v.bsdf->is_diffuse()) return true;  // glossy and specular chains go on
-          if (v.chain >= 1) {                      // light -> non-diffuse surfaces -> here
-            out.push_back({v.p, v.hit->ng, -v.d, v.beta, v.t_ps, v.sigma_ps});
-            ++st.photons_stored;
-          }
-          return false;  // after a diffuse vertex the camera paths take over
-        });
+        walk_light_path(
+            scene, tracker, rng, max_depth, t_cut_ps, st,
+            [&](const LightVertex& v) {
+              if (v.kind != LightVertex::Kind::Surface) return v.kind == LightVertex::Kind::Emitter;
+              if (!v.bsdf->is_diffuse()) return true;  // glossy and specular chains go on
+              if (v.chain >= 1) {                      // light -> non-diffuse surfaces -> here
+                out.push_back({v.p, v.hit->ng, -v.d, v.beta, v.t_ps, v.sigma_ps});
+                ++st.photons_stored;
+              }
+              return false;  // after a diffuse vertex the camera paths take over
+            },
+            false, false, aim);
       },
       comm);
 }

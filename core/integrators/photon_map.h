@@ -12,6 +12,7 @@
 #include "core/pixel_accumulator.h"
 #include "core/scene.h"
 #include "core/temporal_filter.h"
+#include "core/transport/caustic_aim.h"
 #include "core/transport/tracker.h"
 
 namespace femto {
@@ -70,9 +71,12 @@ inline uint64_t photon_pass_bytes(int64_t per_pass) {
 /// Traces `count` photons of one pass (streams keyed by seed, pass and photon index) and returns
 /// the caustic ones in photon order: the same list for any thread count.
 /// `comm`: ranks that share the tracing (core/distributed/comm.h); each counts its own photons.
+/// `aim`: the lights it aims emit towards the non-diffuse shapes only (core/transport/
+/// caustic_aim.h; every stored photon follows one).
 std::vector<Photon> trace_photons(const Scene& scene, uint64_t seed, int pass, int64_t count,
                                   int max_depth, double t_cut_ps, PathStats& stats,
-                                  const distributed::Comm* comm = nullptr);
+                                  const distributed::Comm* comm = nullptr,
+                                  const CausticAim* aim = nullptr);
 
 template <class F>
 void PhotonGrid::query(const Vec3& x, double radius, F&& f) const {

@@ -10,7 +10,7 @@ namespace femto::scene_json {
 // "kernel"}.
 void Loader::photons(const Json& v, const std::string& p, PhotonDesc& d) const {
   const Json& o = object(v, p);
-  check_keys(o, p, {"per_pass", "radius", "bandwidth", "alpha", "beta_t", "kernel"});
+  check_keys(o, p, {"per_pass", "radius", "bandwidth", "alpha", "beta_t", "kernel", "aim"});
   if (const Json* s = find(o, "per_pass"))
     d.per_pass = integer(*s, at(p, "per_pass"), 1, 1000000000LL);
   if (const Json* s = find(o, "radius")) d.radius = number(*s, at(p, "radius"), above(0));
@@ -23,6 +23,10 @@ void Loader::photons(const Json& v, const std::string& p, PhotonDesc& d) const {
     d.kernel = choice(*k, at(p, "kernel"), {"perlin", "epanechnikov"}) == "perlin"
                    ? TemporalKernel::Perlin
                    : TemporalKernel::Epanechnikov;
+  if (const Json* a = find(o, "aim")) {
+    if (!a->is_boolean()) fail(at(p, "aim"), "expected true or false", *a);
+    d.aim = a->get<bool>();
+  }
 }
 
 // Russian roulette on camera paths: true (from vertex 3, throughput threshold 0.2), false, or

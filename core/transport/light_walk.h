@@ -11,6 +11,7 @@
 #include "core/constants.h"
 #include "core/rng.h"
 #include "core/scene.h"
+#include "core/transport/caustic_aim.h"
 #include "core/transport/tracker.h"
 #include "media/phase_hg.h"
 
@@ -63,10 +64,13 @@ inline int medium_at_origin(const Scene& scene, const Ray& ray) {
 /// path whatever the medium's strategy, and every segment in a scattering medium is visited too.
 /// With `rays`, every straight piece in a scattering medium that may still hold a scattering
 /// vertex (depth below max_depth) is visited as a Ray before its distance is sampled.
+/// With `aim`, the lights it aims emit only towards the non-diffuse shapes: for visitors that
+/// store nothing unless the path meets one of those before anything else (core/transport/
+/// caustic_aim.h).
 template <class Visitor>
 void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng, int max_depth,
                      double t_cut_ps, PathStats& stats, Visitor&& visit, bool segments = false,
-                     bool rays = false) {
+                     bool rays = false, const CausticAim* aim = nullptr) {
   const LightSet& lights = scene.lights();
   const auto& media = scene.media();
   const auto& shapes = scene.desc().shapes;
@@ -76,8 +80,12 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
   const int li = lights.pick(rng.uniform(), pmf);
   const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
   LightEmission e;
-  if (li < 0 || !lights.sample_emission(li, u1, u2, u3, u4, e)) return;
+  if (li < 0) return;
   const Light& L = lights.light(li);
+  // An aimed light draws its cone with u3, which point and spot emission leave unused.
+  if (aim && aim->aims(li) ? !aim->sample_emission(L, li, u3, u1, u2, e)
+                           : !lights.sample_emission(li, u1, u2, u3, u4, e))
+    return;
 
   LightVertex v;
   v.t_ps = L.pulse.offset_ps;
