@@ -18,13 +18,26 @@
 #include <vector>
 
 #include "bench/bench_util.h"
+#include "bench/caustics_errors.h"
+#include "bench/caustics_scenes.h"
 #include "core/default_scene.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
 
 using namespace femto;
+using femto::bench::average;
+using femto::bench::blocks;
 using femto::bench::cpu_model;
+using femto::bench::Errors;
+using femto::bench::errors;
+using femto::bench::glass_blocks;
+using femto::bench::housed_emitter_scene;
+using femto::bench::mean_of;
+using femto::bench::median_of;
 using femto::bench::now_s;
+using femto::bench::pixel_sees_sphere;
+using femto::bench::Reference;
+using femto::bench::sphere_emitter_scene;
 
 namespace {
 
@@ -45,14 +58,6 @@ struct Options {
   std::vector<double> hybrid_camera_balls = {-1.0};
 };
 
-/// Median, the mean of the middle two for an even count (bench::median takes the upper one; the
-/// figures in docs/PERFORMANCE.md were made with this one).
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 /// Parses "X,Y,..." into `out`: numbers in [lo, hi]; false on an empty or bad item.
 bool number_list(const std::string& v, double lo, double hi, std::vector<double>& out) {
   out.clear();
@@ -69,67 +74,6 @@ bool number_list(const std::string& v, double lo, double hi, std::vector<double>
   return true;
 }
 
-/// The default scene with its spot light replaced by an emissive sphere of radius r at the same
-/// place, of the same radiant intensity I: a Lambertian sphere has I = Le pi r^2 in every
-/// direction.
-SceneDesc sphere_emitter_scene(const SceneDesc& spot, double r) {
-  SceneDesc d = spot;
-  const LightDesc l = d.lights.front();
-  d.lights.clear();
-  ShapeDesc s;
-  s.type = ShapeDesc::Type::Sphere;
-  s.center = l.position;
-  s.radius = r;
-  s.emissive = true;
-  s.emission = l.intensity / (3.14159265358979323846 * r * r);
-  s.pulse = l.pulse;
-  s.material.type = MaterialDesc::Type::Diffuse;
-  s.material.albedo = RGB(0.0);
-  d.shapes.push_back(s);
-  return d;
-}
-
-/// The same emitter inside a black cone (albedo 0) of the spot's half-angle about its axis, open
-/// towards the scene: it lights the spot's cone only (a hard edge at cone_angle instead of the
-/// spot's falloff from falloff_start), so camera paths face the spot's light, not a lamp that
-/// lights the whole room.
-SceneDesc housed_emitter_scene(const SceneDesc& spot, double r) {
-  SceneDesc d = sphere_emitter_scene(spot, r);
-  const LightDesc& l = spot.lights.front();
-  const Vec3 axis = normalize(l.direction);
-  const double half = l.cone_angle_deg * 3.14159265358979323846 / 180.0;
-  // Apex behind the sphere so that the cone clears it by 5%; 60 mm long.
-  const Vec3 apex = l.position - axis * (1.05 * r / std::sin(half));
-  const double len = 60.0, rim = len * std::tan(half);
-  const Vec3 u = normalize(cross(axis, std::abs(axis.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
-  const Vec3 v = cross(axis, u);
-  ShapeDesc cone;
-  cone.type = ShapeDesc::Type::Mesh;
-  cone.material.type = MaterialDesc::Type::Diffuse;
-  cone.material.albedo = RGB(0.0);
-  const int n = 64;
-  cone.vertices.push_back(apex);
-  for (int k = 0; k < n; ++k) {
-    const double phi = 2.0 * 3.14159265358979323846 * k / n;
-    cone.vertices.push_back(apex + axis * len + (u * std::cos(phi) + v * std::sin(phi)) * rim);
-  }
-  for (uint32_t k = 0; k < static_cast<uint32_t>(n); ++k)
-    cone.triangles.push_back({0, 1 + k, 1 + (k + 1) % static_cast<uint32_t>(n)});
-  d.shapes.push_back(cone);
-  return d;
-}
-
-/// Whether the camera ray of pixel (x, y) through its centre or a corner meets `sphere`.
-bool pixel_sees_sphere(const Camera& cam, int x, int y, const ShapeDesc& sphere) {
-  for (const auto& c : {std::pair<double, double>{0.5, 0.5}, {0, 0}, {1, 0}, {0, 1}, {1, 1}}) {
-    const Ray r = cam.generate_ray(x + c.first, y + c.second);
-    const Vec3 oc = r.o - sphere.center;
-    const double b = dot(oc, r.d), cc = dot(oc, oc) - sphere.radius * sphere.radius;
-    if (b * b - cc > 0 && -b + std::sqrt(b * b - cc) > 0) return true;
-  }
-  return false;
-}
-
 /// Crop pixels whose camera rays (centre and corners) miss the glass sphere.
 std::vector<int> crop_pixels(const Scene& scene, const Options& o, const ShapeDesc& glass) {
   std::vector<int> px;
@@ -138,71 +82,6 @@ std::vector<int> crop_pixels(const Scene& scene, const Options& o, const ShapeDe
     for (int x = o.x0; x < o.x1; ++x)
       if (!pixel_sees_sphere(cam, x, y, glass)) px.push_back(y * cam.width() + x);
   return px;
-}
-
-/// Blocks of B x B pixels holding a pixel whose camera ray (centre or a corner) meets a
-/// dielectric sphere: through glass the camera sees the light itself (a small emitter's image in
-/// the sphere, which no estimator here samples well), not the medium.
-std::vector<bool> glass_blocks(const Scene& scene, int B) {
-  const Camera& cam = scene.camera();
-  const int bw = (cam.width() + B - 1) / B, bh = (cam.height() + B - 1) / B;
-  std::vector<bool> out(static_cast<size_t>(bw * bh), false);
-  for (const ShapeDesc& g : scene.desc().shapes) {
-    if (g.type != ShapeDesc::Type::Sphere || g.material.type != MaterialDesc::Type::Dielectric)
-      continue;
-    for (int y = 0; y < cam.height(); ++y)
-      for (int x = 0; x < cam.width(); ++x)
-        if (pixel_sees_sphere(cam, x, y, g)) out[static_cast<size_t>((y / B) * bw + x / B)] = true;
-  }
-  return out;
-}
-
-struct Errors {
-  double steady = 0, transient = 0;  ///< relative RMSE: RMSE over the crop / mean of the reference
-};
-
-/// A reference as the mean of two independent films (their difference bounds its own error).
-struct Reference {
-  std::vector<double> steady, transient;
-  int bins = 0;
-  Errors own;  ///< its own relative RMSE, from its two halves (default mode)
-};
-
-Reference mean_of(const TransientFilm& a, const TransientFilm& b) {
-  Reference r;
-  r.bins = a.bins();
-  const size_t ns = static_cast<size_t>(a.width()) * static_cast<size_t>(a.height()) * 3;
-  const size_t nt = ns * static_cast<size_t>(a.bins());
-  for (size_t i = 0; i < ns; ++i)
-    r.steady.push_back(0.5 * (static_cast<double>(a.steady()[i]) + b.steady()[i]));
-  for (size_t i = 0; i < nt; ++i)
-    r.transient.push_back(0.5 * (static_cast<double>(a.transient()[i]) + b.transient()[i]));
-  return r;
-}
-
-/// Relative errors of a film (float) or a block sum (double) against ref.
-template <class V>
-Errors errors(const V* steady, const V* transient, const Reference& ref, const std::vector<int>& px,
-              double scale = 1.0) {
-  const int T = ref.bins;
-  double se_s = 0, se_t = 0, m_s = 0, m_t = 0;
-  for (int p : px)
-    for (int c = 0; c < 3; ++c) {
-      const size_t i = static_cast<size_t>(p) * 3 + static_cast<size_t>(c);
-      const double d = scale * steady[i] - ref.steady[i];
-      se_s += d * d;
-      m_s += ref.steady[i];
-      for (int t = 0; t < T; ++t) {
-        const size_t k =
-            (static_cast<size_t>(p) * static_cast<size_t>(T) + static_cast<size_t>(t)) * 3 +
-            static_cast<size_t>(c);
-        const double e = scale * transient[k] - ref.transient[k];
-        se_t += e * e;
-        m_t += ref.transient[k];
-      }
-    }
-  const double n = 3.0 * static_cast<double>(px.size());
-  return {std::sqrt(se_s / n) / (m_s / n), std::sqrt(se_t / (n * T)) / (m_t / (n * T))};
 }
 
 /// `per_pixel`: the hybrid's light paths per pixel per pass (0: its default); `ball`: its camera
@@ -236,48 +115,6 @@ int64_t work_for_budget(const Scene& scene, IntegratorKind kind, const Options& 
   run(scene, kind, probe, o, 999, per_pixel, ball);
   const double dt = now_s() - t0;
   return std::max<int64_t>(1, static_cast<int64_t>(static_cast<double>(probe) * o.seconds / dt));
-}
-
-/// Sums of a film (or reference) over blocks of B x B pixels and G bins, channels kept: the
-/// tissue example's light is a small bright spot and a dim glow, and a per-pixel, per-bin
-/// reference would need hours; the blocks are what is compared there.
-Reference blocks(const std::vector<double>& steady, const std::vector<double>& transient, int W,
-                 int H, int T, int B, int G) {
-  const int bw = (W + B - 1) / B, bh = (H + B - 1) / B, bt = (T + G - 1) / G;
-  Reference r;
-  r.bins = bt;
-  r.steady.assign(static_cast<size_t>(bw * bh) * 3, 0.0);
-  r.transient.assign(static_cast<size_t>(bw * bh * bt) * 3, 0.0);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
-      const size_t q = static_cast<size_t>((y / B) * bw + x / B);
-      for (int c = 0; c < 3; ++c) {
-        r.steady[q * 3 + static_cast<size_t>(c)] += steady[p * 3 + static_cast<size_t>(c)];
-        for (int t = 0; t < T; ++t)
-          r.transient[(q * static_cast<size_t>(bt) + static_cast<size_t>(t / G)) * 3 +
-                      static_cast<size_t>(c)] +=
-              transient[(p * static_cast<size_t>(T) + static_cast<size_t>(t)) * 3 +
-                        static_cast<size_t>(c)];
-      }
-    }
-  return r;
-}
-
-Reference blocks(const TransientFilm& f, int B, int G) {
-  const size_t ns = static_cast<size_t>(f.width()) * static_cast<size_t>(f.height()) * 3;
-  const std::vector<double> s(f.steady(), f.steady() + ns);
-  const std::vector<double> t(f.transient(), f.transient() + ns * static_cast<size_t>(f.bins()));
-  return blocks(s, t, f.width(), f.height(), f.bins(), B, G);
-}
-
-/// The mean of two references of the same layout.
-Reference average(const Reference& a, const Reference& b) {
-  Reference r = a;
-  for (size_t i = 0; i < r.steady.size(); ++i) r.steady[i] = 0.5 * (a.steady[i] + b.steady[i]);
-  for (size_t i = 0; i < r.transient.size(); ++i)
-    r.transient[i] = 0.5 * (a.transient[i] + b.transient[i]);
-  return r;
 }
 
 /// A scene file whose light camera paths cannot reach (the tissue example: a laser behind a

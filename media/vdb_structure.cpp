@@ -213,9 +213,13 @@ void check_transform(Reader& r, uint32_t version, const std::string& where) {
 class FloatTreeCheck {
  public:
   FloatTreeCheck(Reader& topology, Reader& buffers, uint32_t version, uint32_t compression,
-                 bool half, std::string where)
-      : topo_(topology), buf_(buffers), version_(version), compression_(compression),
-        value_bytes_(half ? 2 : 4), where_(std::move(where)) {}
+                 bool half_values, std::string where)
+      : topo_(topology),
+        buf_(buffers),
+        version_(version),
+        compression_(compression),
+        value_bytes_(half_values ? 2 : 4),
+        where_(std::move(where)) {}
 
   /// The root's tiles and children; then each child's branch in the order OpenVDB reads their
   /// buffers: by origin, the last of children with the same origin.
@@ -360,11 +364,11 @@ void check_grid(Reader& r, Reader& data, const Header& h, int index) {
   }
   check_metadata(r, where);
   check_transform(r, version, where);  // after the metadata from file version 216 on
-  const bool half = type == "Tree_float_5_4_3_HalfFloat";
-  if (!instance && (type == "Tree_float_5_4_3" || half)) {
+  const bool half_values = type == "Tree_float_5_4_3_HalfFloat";
+  if (!instance && (type == "Tree_float_5_4_3" || half_values)) {
     data.seek(static_cast<uint64_t>(block));
     data.set_end(static_cast<uint64_t>(end));
-    FloatTreeCheck(r, data, version, compression, half, where).root();
+    FloatTreeCheck(r, data, version, compression, half_values, where).root();
   }
   r.set_end(r.size());
   r.seek(static_cast<uint64_t>(end));

@@ -152,6 +152,15 @@ SceneDesc furnace_scene(double rho, double Le, double sigma_s, double g) {
   return d;
 }
 
+#ifdef FEMTO_TEST_SANITIZED
+// Instrumented, the furnace renders an eighth of the samples: the sanitizers look for memory and
+// undefined-behaviour errors, and the Release build keeps the full test with its resolving power
+// (69-78 s of the sanitizer ctest at full count).
+constexpr int kFurnaceSpp = 8;
+#else
+constexpr int kFurnaceSpp = 64;
+#endif
+
 void check_furnace(double sigma_s, double g, bool medium_in_sphere = false) {
   const double rho = 0.5, Le = 1.0, expected = Le / (1.0 - rho);
   SceneDesc desc = furnace_scene(rho, Le, medium_in_sphere ? 0.0 : sigma_s, g);
@@ -166,7 +175,7 @@ void check_furnace(double sigma_s, double g, bool medium_in_sphere = false) {
     ball.interior_medium = static_cast<int>(desc.media.size()) - 1;
     desc.shapes.push_back(ball);
   }
-  const auto films = render_batches(desc, 64, 16);
+  const auto films = render_batches(desc, kFurnaceSpp, 16);
   std::vector<double> means;
   double after = 0;
   for (const auto& f : films) {
@@ -177,7 +186,7 @@ void check_furnace(double sigma_s, double g, bool medium_in_sphere = false) {
   }
   const MeanSE m = mean_se(means);
   INFO("mean " << m.mean << " +- " << m.se << ", expected " << expected << ", after window " << after);
-  CHECK(m.se < 0.02 * expected);  // the test has resolving power
+  if (kFurnaceSpp == 64) CHECK(m.se < 0.02 * expected);  // the test has resolving power
   CHECK(std::abs(m.mean - expected) < 4.0 * m.se);
 }
 }  // namespace
