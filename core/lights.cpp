@@ -123,7 +123,7 @@ bool LightSet::sample(int i, const Vec3& x, double u1, double u2, LightSample& l
       ls.is_delta = true;
       double falloff = 1.0;
       if (l.type == Light::Type::Spot) {
-        falloff = smoothstep(l.cos_cone, l.cos_falloff, dot(-ls.wi, l.direction));
+        falloff = spot_falloff(l, dot(-ls.wi, l.direction));
         if (falloff <= 0) return false;
       }
       ls.Li = l.intensity * (falloff / d2);
@@ -223,7 +223,7 @@ bool LightSet::sample_emission(int i, double u1, double u2, double u3, double u4
       const SinCos phi = sincos_2pi(u2);
       const Vec3 d =
           normalize(Frame(l.direction).to_world({sin_t * phi.cos, sin_t * phi.sin, cos_t}));
-      const double falloff = smoothstep(l.cos_cone, l.cos_falloff, cos_t);
+      const double falloff = spot_falloff(l, cos_t);
       if (!(falloff > 0)) return false;
       e.ray = {l.position, d};
       e.beta = l.intensity * (falloff * 2.0 * kPi * (1.0 - l.cos_cone));

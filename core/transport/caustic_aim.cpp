@@ -33,11 +33,8 @@ void bounding_sphere(const ShapeDesc& sh, Vec3& c, double& r) {
 }
 
 // Whether unit direction d lies in the cone: by the sine, which keeps narrow cones exact.
-bool in_cone(const CausticAim::Cone& k, double sin2_max, const Vec3& d) {
-  return dot(d, k.axis) > 0 && length_squared(cross(d, k.axis)) <= sin2_max;
-}
-double sin2_of(const CausticAim::Cone& k) {
-  return k.one_minus * (1 + k.cos_max);
+bool in_cone(const CausticAim::Cone& k, const Vec3& d) {
+  return dot(d, k.axis) > 0 && length_squared(cross(d, k.axis)) <= k.sin2_max;
 }
 }  // namespace
 
@@ -68,6 +65,7 @@ CausticAim::CausticAim(const SceneDesc& desc, const LightSet& lights) {
       const double sin2 = (r / dist) * (r / dist);
       k.cos_max = std::sqrt(1 - sin2);
       k.one_minus = sin2 / (1 + k.cos_max);
+      k.sin2_max = k.one_minus * (1 + k.cos_max);
       k.solid_angle = 2 * kPi * k.one_minus;
       // A spot never emits into a cone wholly outside its own.
       const double apart = std::acos(std::clamp(dot(k.axis, l.direction), -1.0, 1.0));
@@ -104,7 +102,7 @@ double CausticAim::path_share(const LightSet& lights) const {
 double CausticAim::pdf(int i, const Vec3& d) const {
   const PerLight& pl = per_light_[static_cast<size_t>(i)];
   int count = 0;
-  for (const Cone& k : pl.cones) count += in_cone(k, sin2_of(k), d);
+  for (const Cone& k : pl.cones) count += in_cone(k, d);
   return count > 0 ? count / pl.total : 0.0;
 }
 
@@ -125,7 +123,7 @@ bool CausticAim::sample_emission(const Light& l, int i, double u_cone, double u1
   // The mixture's pdf: the drawn cone always counts (rounding at its rim must not drop it).
   int count = 1;
   for (size_t j = 0; j < pl.cones.size(); ++j)
-    if (j != c) count += in_cone(pl.cones[j], sin2_of(pl.cones[j]), d);
+    if (j != c) count += in_cone(pl.cones[j], d);
   double falloff = 1;
   if (l.type == Light::Type::Spot) {
     falloff = spot_falloff(l, dot(d, l.direction));

@@ -22,6 +22,7 @@ class CausticAim {
     Vec3 axis;               ///< unit, light -> sphere centre
     double cos_max = 1;      ///< cosine of the half-angle
     double one_minus = 0;    ///< 1 - cos_max, without cancellation
+    double sin2_max = 0;     ///< sin^2 of the half-angle
     double solid_angle = 0;  ///< 2 pi (1 - cos_max), sr
   };
 
