@@ -8,6 +8,7 @@
 #include "core/constants.h"
 #include "core/integrators/connection_choice.h"
 #include "core/integrators/volpath.h"
+#include "core/spot_cone.h"
 #include "media/phase_hg.h"
 #include "samplers/angular.h"
 #include "samplers/distance.h"
@@ -194,8 +195,11 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Connect
                                        : line_to_point_target(med, segment, L, use_lp);
   const double s_end = target.s_end;
   if (!(s_end > 0)) return;
-  const EquiangularSampler eq(ray.o, ray.d, p, 0.0, s_end);
-  const bool eq_ok = use_eq && eq.valid(), lp_ok = use_lp && target.valid;
+  // A spot lights only the stretch of the segment inside its cone (core/spot_cone.h).
+  double eq_a = 0.0, eq_b = s_end;
+  const bool lit = L.type != Light::Type::Spot || spot_cone_interval(L, ray, eq_a, eq_b);
+  const EquiangularSampler eq(ray.o, ray.d, p, eq_a, eq_b);
+  const bool eq_ok = use_eq && lit && eq.valid(), lp_ok = use_lp && target.valid;
 
   auto contribute = [&](double s) {
     if (!(s < s_end)) return;
