@@ -10,6 +10,7 @@
 #include <set>
 #include <nlohmann/json.hpp>
 
+#include "cli_helpers.h"
 #include "core/checkpoint.h"
 #include "core/error.h"
 #include "core/io/sha256.h"
@@ -27,19 +28,11 @@ using json = nlohmann::json;
 
 namespace {
 
+// The command-line tests' scene (cli::cli_scene) with its own seed and time bins.
 std::string scene_text(int w = 24, int h = 20, int bins = 12, bool glass = false) {
-  json s = json::parse(R"({
-    "camera": { "type": "perspective", "position": [0, 0, 100], "look_at": [0, 0, 0], "fov": 40 },
-    "time": { "t_start": 0, "bin_width": 60, "bins": 12, "mode": "camera" },
-    "media": { "fog": { "type": "homogeneous", "sigma_a": 0.001, "sigma_s": 0.01, "g": 0.3, "eta": 1.0 } },
-    "medium": "fog",
-    "shapes": [
-      { "type": "quad", "corner": [-60, -60, 0], "edge1": [120, 0, 0], "edge2": [0, 120, 0],
-        "material": { "type": "diffuse", "albedo": 0.7 } }
-    ],
-    "lights": [ { "type": "point", "position": [10, 20, 50], "intensity": 1000 } ],
-    "render": { "spp": 4, "max_depth": 100, "seed": 3 }
-  })");
+  json s = cli::cli_scene();
+  s["time"]["bin_width"] = 60;
+  s["render"]["seed"] = 3;
   s["camera"]["resolution"] = {w, h};
   s["time"]["bins"] = bins;
   if (glass)
