@@ -5,9 +5,11 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <vector>
 
 #include <filesystem>
@@ -64,6 +66,8 @@ inline PhotonDesc progressive(int64_t per_pass, double radius_mm, double bandwid
 inline std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kind, int64_t work,
                                           int n, uint64_t seed0, const PhotonDesc& photons = {}) {
   std::vector<TransientFilm> films;
+  const auto start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
   for (int b = 0; b < n; ++b) {
     RenderOptions opt;
     opt.integrator = kind;
@@ -75,6 +79,12 @@ inline std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kin
     opt.quiet = true;
     films.push_back(render(scene, opt).film);
   }
+  // FEMTO_AGREEMENT_LOG=1 (below): each side's time, to balance a test's budget between them.
+  if (std::getenv("FEMTO_AGREEMENT_LOG"))
+    std::fprintf(stderr, "batches: integrator %d, %lld x %d, %.2f s (CPU %.2f s)\n",
+                 static_cast<int>(kind), static_cast<long long>(work), n,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                 static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC);
   return films;
 }
 
