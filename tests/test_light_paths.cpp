@@ -234,7 +234,9 @@ TEST_CASE("the hybrid without a medium agrees with light tracing on a caustic fr
     CHECK(r.photons.seconds_beams == 0);
     CHECK(r.photons.hybrid_light_paths > 0);
   }
-  const PhotonDesc pd = progressive(400, 0.5, 1.0);
+  // The cells compared hold little of the photons' light (a camera path's second diffuse
+  // vertex): 400 paths a pass gave the same errors to four digits at 2.3x the hybrid's CPU time.
+  const PhotonDesc pd = progressive(100, 0.5, 1.0);
   const auto hy = cells(batches(scene, IntegratorKind::Hybrid, 1024, 24, 730, pd), 3, 2);
   const auto lt = cells(batches(scene, IntegratorKind::Light, 80000, 24, 830), 3, 2);
   require_agreement(hy, lt, 10);
