@@ -52,9 +52,9 @@ std::vector<bool> cells_seeing_sphere(const Scene& scene, const Vec3& c, double 
 /// sphere): with 1/8 to 1/16 of the paths per pass, the hybrid's standard errors stayed the same to
 /// four digits, and neither beams nor photons at twice their weight failed them. So they take few
 /// paths there; the caustic beams' weight is checked by the laser test, the photons' by the wall
-/// test (both below), and all beams by tests/test_photon_beams.cpp. Light tracing's errors are 1/6
-/// to 1/2 of the hybrid's, so it takes 40000 paths instead of 60000: the combined errors grew by
-/// 1%.
+/// test (both below), and all beams by tests/test_photon_beams.cpp. Light tracing's errors there
+/// are about a quarter of the hybrid's, so it takes 40000 paths instead of 60000: the combined
+/// errors grew by 1%.
 void hybrid_matches_light_tracing(const Scene& scene, const Vec3& sphere, uint64_t seed_light,
                                   uint64_t seed_hybrid, int64_t photons, int min_cells = 12,
                                   double resolution = 0.02) {
@@ -84,7 +84,7 @@ TEST_CASE("hybrid agrees with light tracing on a volumetric caustic from a point
 // non-diffuse surfaces precede). One spot's cone lies inside the sphere's silhouette, so the
 // bright disk under the sphere is all caustic; the other's reflects off a rough metal plate. The
 // point-light scene above lights its floor mostly from the fog and would hide either error.
-// Measured (with 60000 light-tracing paths; now 40000, which leaves the combined errors within 3%):
+// Measured (with 60000 light-tracing paths; now 40000, which leaves the combined errors within 1%):
 // max |z| 14.6 without the splat, 7.0 with photons gathered there as well, 6.0 if the splat
 // takes only mirror and glass chains (not rough metal); 3.4 as built (2.1 with seeds 1800 and
 // 1900: the hybrid's cells are heavy-tailed).
