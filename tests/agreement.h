@@ -61,13 +61,31 @@ inline PhotonDesc progressive(int64_t per_pass, double radius_mm, double bandwid
   return pd;
 }
 
+/// Wall and process CPU time spent on one side of a comparison, summed over `run` calls;
+/// FEMTO_AGREEMENT_LOG=1 has `log` print it, to balance a test's budget between its two sides.
+struct SideTime {
+  double wall = 0, cpu = 0;
+  template <class F>
+  auto run(F&& f) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::clock_t cpu_start = std::clock();
+    auto result = f();
+    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    cpu += static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+    return result;
+  }
+  void log(const std::string& what) const {
+    if (std::getenv("FEMTO_AGREEMENT_LOG"))
+      std::fprintf(stderr, "%s: %.2f s (CPU %.2f s)\n", what.c_str(), wall, cpu);
+  }
+};
+
 /// One film per seed (seed0, seed0 + 1, ...) with the given integrator; `work` is spp (passes) or,
 /// for light tracing, light paths.
 inline std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kind, int64_t work,
                                           int n, uint64_t seed0, const PhotonDesc& photons = {}) {
   std::vector<TransientFilm> films;
-  const auto start = std::chrono::steady_clock::now();
-  const std::clock_t cpu_start = std::clock();
+  SideTime elapsed;
   for (int b = 0; b < n; ++b) {
     RenderOptions opt;
     opt.integrator = kind;
@@ -77,14 +95,10 @@ inline std::vector<TransientFilm> batches(const Scene& scene, IntegratorKind kin
     opt.seed = seed0 + static_cast<uint64_t>(b);
     opt.threads = 2;
     opt.quiet = true;
-    films.push_back(render(scene, opt).film);
+    films.push_back(elapsed.run([&] { return render(scene, opt).film; }));
   }
-  // FEMTO_AGREEMENT_LOG=1 (below): each side's time, to balance a test's budget between them.
-  if (std::getenv("FEMTO_AGREEMENT_LOG"))
-    std::fprintf(stderr, "batches: integrator %d, %lld x %d, %.2f s (CPU %.2f s)\n",
-                 static_cast<int>(kind), static_cast<long long>(work), n,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-                 static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC);
+  elapsed.log("batches: integrator " + std::to_string(static_cast<int>(kind)) + ", " +
+              std::to_string(work) + " x " + std::to_string(n));
   return films;
 }
 

@@ -6,9 +6,6 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <ctime>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -43,7 +40,7 @@ const char* kFogAroundCamera = R"({
 void ball_agrees(const Scene& scene, int passes, IntegratorKind reference, int64_t ref_work,
                  uint64_t seed0, int group, int min_cells, double resolution) {
   std::vector<TransientFilm> hybrid, ref;
-  std::clock_t ref_cpu = 0, hy_cpu = 0;
+  SideTime ref_time, hybrid_time;
   for (int b = 0; b < 24; ++b) {
     RenderOptions opt;
     opt.seed = seed0 + static_cast<uint64_t>(b);
@@ -52,25 +49,18 @@ void ball_agrees(const Scene& scene, int passes, IntegratorKind reference, int64
     opt.integrator = reference;
     opt.spp = reference == IntegratorKind::Light ? 1 : static_cast<int>(ref_work);
     opt.light_paths = reference == IntegratorKind::Light ? ref_work : 0;
-    const std::clock_t c0 = std::clock();
-    ref.push_back(render(scene, opt).film);
-    ref_cpu += std::clock() - c0;
+    ref.push_back(ref_time.run([&] { return render(scene, opt).film; }));
     opt.integrator = IntegratorKind::Hybrid;
     opt.spp = passes;
     opt.light_paths = 0;
     opt.camera_ball_mm = 12;
-    const std::clock_t c1 = std::clock();
-    const RenderResult r = render(scene, opt);
-    hy_cpu += std::clock() - c1;
+    const RenderResult r = hybrid_time.run([&] { return render(scene, opt); });
     REQUIRE(r.photons.camera_ball_radius == 12.0);
     CHECK(r.photons.camera_ball_beams_max > 0);
     hybrid.push_back(r.film);
   }
-  // FEMTO_AGREEMENT_LOG=1: each side's CPU time, as batches() prints it (tests/agreement.h).
-  if (std::getenv("FEMTO_AGREEMENT_LOG"))
-    std::fprintf(stderr, "camera ball: reference CPU %.2f s, hybrid CPU %.2f s\n",
-                 static_cast<double>(ref_cpu) / CLOCKS_PER_SEC,
-                 static_cast<double>(hy_cpu) / CLOCKS_PER_SEC);
+  ref_time.log("camera ball: reference");
+  hybrid_time.log("camera ball: hybrid");
   require_agreement(cells(hybrid, 4, group), cells(ref, 4, group), min_cells, resolution);
 }
 
