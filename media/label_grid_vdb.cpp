@@ -3,35 +3,33 @@
 #include <openvdb/openvdb.h>
 
 #include <cmath>
-#include <mutex>
 
 #include "core/error.h"
 #include "core/io/atomic_file.h"
+#include "media/vdb_init.h"
+#include "media/vdb_new_grid.h"
 
 namespace femto {
 
 namespace {
 constexpr double kMaxCells = 1073741824.0;  // 2^30, as for density volumes
-void init() {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
 }  // namespace
 
 LabelGridData read_vdb_labels(const std::string& path, const std::string& name,
                               const std::string& where) {
-  init();
+  vdb_load::init_openvdb();
   const std::string at = where + ": " + clip(path, 200) + ": ";
   openvdb::Int32Grid::Ptr grid;
   try {
     openvdb::io::File file(path);
     file.open(false);
     if (!file.hasGrid(name)) throw InputError(at + "no grid named '" + clip(name) + "'");
-    const openvdb::GridBase::Ptr base = file.readGrid(name);
-    grid = openvdb::gridPtrCast<openvdb::Int32Grid>(base);
-    if (!grid)
-      throw InputError(at + "grid '" + clip(name) + "' is of type " + base->valueType() +
+    // The type from the grid's header: a grid of another type is refused before it is read.
+    const openvdb::GridBase::Ptr meta = file.readGridMetadata(name);
+    if (!meta->isType<openvdb::Int32Grid>())
+      throw InputError(at + "grid '" + clip(name) + "' is of type " + clip(meta->valueType()) +
                        "; labels need an Int32 grid");
+    grid = openvdb::gridPtrCast<openvdb::Int32Grid>(file.readGrid(name));
     file.close();
   } catch (const InputError&) {
     throw;
@@ -67,8 +65,8 @@ LabelGridData read_vdb_labels(const std::string& path, const std::string& name,
 }
 
 void write_vdb_labels(const std::string& path, const std::string& name, const LabelGridData& d) {
-  init();
-  const auto grid = openvdb::Int32Grid::create(0);
+  vdb_load::init_openvdb();
+  const auto grid = new_vdb_grid<openvdb::Int32Grid>(0);
   auto acc = grid->getAccessor();
   size_t i = 0;
   for (int x = 0; x < d.n[0]; ++x)

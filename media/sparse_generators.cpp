@@ -12,6 +12,8 @@
 #include "core/io/atomic_file.h"
 #include "core/rng.h"
 #include "media/openvdb_headers.h"
+#include "media/vdb_init.h"
+#include "media/vdb_new_grid.h"
 
 namespace femto {
 namespace {
@@ -44,7 +46,7 @@ double value_noise(uint64_t key, double px, double py, double pz) {
 // centre (<= 0: inactive).
 template <class Near, class Density>
 FloatGrid::Ptr generate(const int dims[3], Near near, Density density) {
-  openvdb::initialize();
+  vdb_load::init_openvdb();
   const int nl[3] = {(dims[0] + 7) / 8, (dims[1] + 7) / 8, (dims[2] + 7) / 8};
   std::vector<std::vector<Leaf*>> slabs(static_cast<size_t>(nl[2]));
   tbb::parallel_for(tbb::blocked_range<int>(0, nl[2]), [&](const tbb::blocked_range<int>& r) {
@@ -69,7 +71,7 @@ FloatGrid::Ptr generate(const int dims[3], Near near, Density density) {
           if (leaf) slabs[static_cast<size_t>(lk)].push_back(leaf);
         }
   });
-  FloatGrid::Ptr grid = FloatGrid::create(0.0f);
+  FloatGrid::Ptr grid = new_vdb_grid<FloatGrid>(0.0f);
   for (auto& slab : slabs)
     for (Leaf* leaf : slab) grid->tree().addLeaf(leaf);  // the tree owns it from here
   return grid;

@@ -1,6 +1,7 @@
 // Writing .vdb files (write_vdb, write_volume): for the volume generator and the tests.
 #include "core/error.h"
 #include "core/io/atomic_file.h"
+#include "media/vdb_new_grid.h"
 #include "media/volume_loader.h"
 
 namespace femto {
@@ -15,7 +16,7 @@ using vdb_load::init_openvdb;
 template <typename GridT>
 openvdb::GridBase::Ptr make_grid(const VdbGridSpec& s) {
   using V = typename GridT::ValueType;
-  const auto grid = GridT::create(static_cast<V>(s.background));
+  const auto grid = new_vdb_grid<GridT>(static_cast<V>(s.background));
   auto acc = grid->getAccessor();
   const Coord off(static_cast<int>(s.index_offset.x), static_cast<int>(s.index_offset.y),
                   static_cast<int>(s.index_offset.z));

@@ -2,18 +2,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <mutex>
 
 #include "core/error.h"
 #include "media/vdb_structure.h"
 #include "media/volume_loader.h"
 
 namespace femto::vdb_load {
-
-void init_openvdb() {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
 
 std::string fmt(double v) {
   char buf[32];

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "media/openvdb_headers.h"
+#include "media/vdb_init.h"
 #include "media/volume_data.h"
 
 namespace femto::vdb_load {
@@ -23,9 +24,6 @@ constexpr double kMaxCells = 1073741824.0;  // 2^30 = 1024^3 dense cells
 constexpr uint64_t kMaxDenseBytes = 16ull << 30;
 constexpr double kMaxWorld = 1e9;   // mm, as for scene coordinates
 constexpr double kMaxSigmaT = 1e9;  // 1/mm: sigma_t is stored as float
-
-/// openvdb::initialize(), once per process (reading and writing need it).
-void init_openvdb();
 
 // Numbers, vectors and voxel coordinates in messages (volume_loader.cpp).
 std::string fmt(double v);

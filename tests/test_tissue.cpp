@@ -16,6 +16,7 @@
 #include "core/tissue/simulate.h"
 #include "core/transport/tissue_walk.h"
 #include "media/label_grid_vdb.h"
+#include "media/volume_data.h"
 #include "run_femto.h"
 #include "temp_dir.h"
 #include "tissue_setups.h"
@@ -313,6 +314,15 @@ TEST_CASE("label volumes load from NIfTI-1 and OpenVDB", "[tissue]") {
   CHECK(v.volume.origin.x == Approx(1));
   CHECK(v.volume.origin.z == Approx(3));
   for (size_t i = 0; i < g.labels.size(); ++i) CHECK(v.volume.labels[i] == g.labels[i]);
+
+  // A float grid where labels are expected: refused by its type, naming the file and the grid.
+  DenseGrid density(2, 2, 2, 1.0f);
+  const std::string fog = (tmp.dir / "fog.vdb").string();
+  write_volume(fog, density, nullptr, nullptr, 0.5, Vec3(0), "labels");
+  CHECK_THROWS_WITH(load_tissue_scene(R"({"tissue": {"volume": {"vdb": "fog.vdb"},)" + labels + "}",
+                                      "t.json", tmp.dir.string()),
+                    Catch::Contains("fog.vdb: grid 'labels' is of type float; labels need an "
+                                    "Int32 grid"));
 }
 
 // Catches bad tissue scenes that run anyway or leave files behind: exit 2, one message naming the
