@@ -15,8 +15,6 @@ void init_openvdb() {
     // and all its virtual functions into this file. The registry refuses a second factory.
     openvdb::FloatGrid::unregisterGrid();
     openvdb::FloatGrid::registerGrid();
-    openvdb::Int32Grid::unregisterGrid();
-    openvdb::Int32Grid::registerGrid();
 #endif
   });
 }
