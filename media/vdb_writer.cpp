@@ -1,8 +1,9 @@
 // Writing .vdb files (write_vdb, write_volume): for the volume generator and the tests.
 #include "core/error.h"
 #include "core/io/atomic_file.h"
+#include "media/vdb_init.h"
 #include "media/vdb_new_grid.h"
-#include "media/volume_loader.h"
+#include "media/volume_data.h"
 
 namespace femto {
 
