@@ -111,6 +111,7 @@ void trace_chunk(const Setup& s, const Space& space, const Emitter& emitter, con
     WalkSettings stop = ws;
     if (!last) stop.t_end = s.time.bin_start_ps(j + 1);
     size_t kept = 0;
+    if (s.fluence) tally.gate(j);
     for (Walker& w : walkers) {
       tally.begin(w.slot);
       const bool on = walk_until(space, stop, last, w.p, w.rng, tally, out);

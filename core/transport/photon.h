@@ -48,6 +48,7 @@ struct Segment {
   double v = 0;             ///< speed c / n, mm/ps
   double w0 = 1;            ///< weight at the start
   double k = 0;             ///< weight decay rate along the segment, 1/ps (weighted absorption)
+  double mu = 0;            ///< the same per mm: k / v
   double absorbed = 0;      ///< w0 (1 - exp(-k duration)): the energy absorbed along the segment
   int scatterings = 0;      ///< scattering events before this segment (0: unscattered light)
   double distance = 0;      ///< geometric length, mm (tissue walk; v * duration up to rounding)

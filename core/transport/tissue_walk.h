@@ -41,9 +41,14 @@ enum class StepEvent {
 struct WalkOptics {
   double mu_a = 0, mu_s = 0, mu_t = 0, g = 0, n = 1;
   double v = kSpeedOfLight;  ///< c / n, mm/ps
-  static WalkOptics of(const TissueOptics& o) {
-    return {o.mu_a, o.mu_s, o.mu_a + o.mu_s, o.g, o.n, kSpeedOfLight / o.n};
+  // Reciprocals (+inf for 0): a step multiplies instead of dividing.
+  double inv_mu_s = kInf, inv_mu_t = kInf, inv_v = 1 / kSpeedOfLight;
+  static WalkOptics of(double mu_a, double mu_s, double g, double n) {
+    const double mu_t = mu_a + mu_s, v = kSpeedOfLight / n;
+    return {mu_a, mu_s, mu_t, g, n, v, mu_s > 0 ? 1 / mu_s : kInf, mu_t > 0 ? 1 / mu_t : kInf,
+            1 / v};
   }
+  static WalkOptics of(const TissueOptics& o) { return of(o.mu_a, o.mu_s, o.g, o.n); }
 };
 
 struct WalkSettings {
@@ -148,6 +153,45 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
   return s;
 }
 
+/// The voxel faces crossed by the piece p.x + p.d s, s in [0, s_stop), in closed form when it
+/// crosses at most one face per axis (most steps: a mean free path is about a voxel), without the
+/// march's unpredictable choice of the next axis: the up to three face distances are sorted by a
+/// fixed network. Every voxel on the way must have p's label (a safe box). Returns false, with
+/// nothing written, when an axis has two or more faces before s_stop (the march's case).
+inline bool crossings_closed_form(const LabelVolume& vol, const Photon& p, double s_stop,
+                                  int end_cell[3], VoxelCrossings& crossed) {
+  double t[3];
+  bool cross[3];
+  bool single = true;
+  for (int a = 0; a < 3; ++a) {
+    const double d = p.d[a];
+    const bool up = d > 0;
+    const double face = vol.origin[a] + (p.cell[a] + (up ? 1 : 0)) * vol.voxel;
+    const double inv_d = 1 / d;  // one division per axis
+    const double ta = d != 0 ? std::max(0.0, (face - p.x[a]) * inv_d) : kInf;
+    const double delta = d != 0 ? vol.voxel * std::abs(inv_d) : kInf;
+    cross[a] = ta < s_stop;
+    single &= !(ta + delta < s_stop);
+    t[a] = cross[a] ? ta : kInf;
+    end_cell[a] = p.cell[a] + (cross[a] ? (up ? 1 : -1) : 0);
+  }
+  if (!single) return false;
+  // Sort (t, axis) by t: three compare-exchanges; ties keep the lower axis first.
+  int ax[3] = {0, 1, 2};
+  auto exchange = [&](int i, int j) {
+    const bool swap = t[j] < t[i];
+    const double ti = t[i], tj = t[j];
+    const int ai = ax[i], aj = ax[j];
+    t[i] = swap ? tj : ti, t[j] = swap ? ti : tj;
+    ax[i] = swap ? aj : ai, ax[j] = swap ? ai : aj;
+  };
+  exchange(0, 1), exchange(1, 2), exchange(0, 1);
+  const int count = int{cross[0]} + int{cross[1]} + int{cross[2]};
+  for (int q = 0; q < 3; ++q) crossed.s[q] = t[q], crossed.axis[q] = static_cast<int8_t>(ax[q]);
+  crossed.count = count;
+  return true;
+}
+
 /// Puts p exactly on the face of its voxel on `axis` that it moves towards (no drift) and gives
 /// the voxel beyond that face.
 inline void face_neighbour(const LabelVolume& vol, Photon& p, int axis, int next[3]) {
@@ -216,6 +260,8 @@ class LabelSpace {
     const int safe = safe_[vol_.index(p.cell[0], p.cell[1], p.cell[2])];
     const Vec3 x1 = p.x + p.d * s_stop;
     if (inside_safe_box(vol_, p.cell, safe, x1, margin_)) {
+      if (crossed && crossings_closed_form(vol_, p, s_stop, end_cell, *crossed))
+        return std::numeric_limits<double>::infinity();
       if (crossed)  // the faces for a tally; every neighbour has the label
         return march_to_change(vol_, p, s_stop, axis, end_cell, crossed,
                                [](ptrdiff_t) { return true; });
@@ -272,7 +318,7 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   const double rate = analog ? o.mu_t : o.mu_s;
   if (p.tau_left < 0) p.tau_left = -std::log(1 - rng.uniform());  // 1 - u is exact
   int axis = 0, end_cell[3];
-  const double s_event = rate > 0 ? p.tau_left / rate : kInf;
+  const double s_event = rate > 0 ? p.tau_left * (analog ? o.inv_mu_t : o.inv_mu_s) : kInf;
   const double s_window = (ws.t_end - p.t) * o.v;
   const double s_face =
       space.distance_to_interface(p, std::min(s_event, s_window), axis, end_cell, seg.crossings);
@@ -287,9 +333,10 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   }
   seg.x0 = p.x, seg.d = p.d, seg.t0 = p.t, seg.v = o.v, seg.w0 = p.w;
   seg.k = analog ? 0.0 : o.mu_a * o.v;
+  seg.mu = analog ? 0.0 : o.mu_a;
   seg.scatterings = p.scatterings, seg.label = p.label;
   seg.cell[0] = p.cell[0], seg.cell[1] = p.cell[1], seg.cell[2] = p.cell[2];
-  seg.duration = s / o.v;
+  seg.duration = s * o.inv_v;
   seg.distance = s;
   if (!std::isfinite(s)) {  // an endless flight: everything is absorbed on the way (if mu_a > 0)
     seg.absorbed = seg.k > 0 ? p.w : 0.0;
@@ -298,7 +345,7 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
     p.t = kInf;
     return StepEvent::Lost;
   }
-  const double x = seg.k * seg.duration;
+  const double x = seg.mu * s;  // k duration
   seg.absorbed = x > 0 ? p.w * one_minus_exp(x) : 0.0;
   p.w -= seg.absorbed;  // absorbed + carried = w0 exactly, up to one rounding
   p.x += p.d * s;

@@ -24,8 +24,7 @@ class VoxelSpace {
   WalkOptics optics_at(const Photon& p) const {
     if (p.label == 0) return outside_;
     const VoxelOptics& v = voxel(p.cell);
-    const double mu_a = v.mu_a, mu_s = v.mu_s, n = v.n;
-    return {mu_a, mu_s, mu_a + mu_s, g_, n, kSpeedOfLight / n};
+    return WalkOptics::of(v.mu_a, v.mu_s, g_, v.n);
   }
 
   /// As LabelSpace::distance_to_interface, with "the same optics" in place of "the same label".
