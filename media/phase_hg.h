@@ -30,8 +30,9 @@ struct PhaseSample {
   double value;  ///< phase function value (= pdf for HG)
 };
 
-/// Samples a new propagation direction around the current propagation direction `d`.
-inline PhaseSample hg_sample(const Vec3& d, double g, double u1, double u2) {
+/// Samples a new propagation direction around the current propagation direction `d` (photon
+/// walks: no phase value needed).
+inline Vec3 hg_sample_direction(const Vec3& d, double g, double u1, double u2) {
   const double cos_t = hg_sample_cos(u1, g);
   const double sin2_t = 1.0 - cos_t * cos_t;
   const double sin_t = std::sqrt(sin2_t > 0.0 ? sin2_t : 0.0);
@@ -40,7 +41,12 @@ inline PhaseSample hg_sample(const Vec3& d, double g, double u1, double u2) {
   const Vec3 dir = f.to_world({sin_t * phi.cos, sin_t * phi.sin, cos_t});
   // |dir| is 1 to a few ulp (an orthonormal frame of a unit d): one Newton step of 1/sqrt at 1
   // makes it 1 to rounding without a square root or a division, and keeps d from drifting.
-  return {dir * (1.5 - 0.5 * dot(dir, dir)), hg_eval(cos_t, g)};
+  return dir * (1.5 - 0.5 * dot(dir, dir));
+}
+
+/// Samples a new propagation direction around `d`, with the phase function's value there.
+inline PhaseSample hg_sample(const Vec3& d, double g, double u1, double u2) {
+  return {hg_sample_direction(d, g, u1, u2), hg_eval(hg_sample_cos(u1, g), g)};
 }
 
 }  // namespace femto

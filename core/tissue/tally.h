@@ -191,15 +191,10 @@ class Tally {
   }
 
   // The integral of exp(-mu u) over u in [0, s], mu >= 0: s (1 - e^-x) / x with x = mu s; a
-  // series for x < 0.05 (no exponential; truncated after x^6, the relative error is below
-  // x^7 / 8! < 2e-14).
+  // series for x < 0.05 (no exponential).
   static double decay_integral(double mu, double s) {
     const double x = mu * s;
-    if (x < 0.05)
-      return s *
-             (1 - x * (1.0 / 2 -
-                       x * (1.0 / 6 - x * (1.0 / 24 -
-                                           x * (1.0 / 120 - x * (1.0 / 720 - x * (1.0 / 5040)))))));
+    if (x < 0.05) return s * exp_mean_series(x);
     return -std::expm1(-x) / mu;
   }
 
