@@ -30,10 +30,8 @@ struct PhaseSample {
   double value;  ///< phase function value (= pdf for HG)
 };
 
-/// Samples a new propagation direction around the current propagation direction `d` (photon
-/// walks: no phase value needed).
-inline Vec3 hg_sample_direction(const Vec3& d, double g, double u1, double u2) {
-  const double cos_t = hg_sample_cos(u1, g);
+/// The direction at polar cosine cos_t and azimuth 2 pi u2 around the propagation direction `d`.
+inline Vec3 direction_around(const Vec3& d, double cos_t, double u2) {
   const double sin2_t = 1.0 - cos_t * cos_t;
   const double sin_t = std::sqrt(sin2_t > 0.0 ? sin2_t : 0.0);
   const SinCos phi = sincos_2pi(u2);
@@ -44,9 +42,16 @@ inline Vec3 hg_sample_direction(const Vec3& d, double g, double u1, double u2) {
   return dir * (1.5 - 0.5 * dot(dir, dir));
 }
 
+/// Samples a new propagation direction around the current propagation direction `d` (photon
+/// walks: no phase value needed).
+inline Vec3 hg_sample_direction(const Vec3& d, double g, double u1, double u2) {
+  return direction_around(d, hg_sample_cos(u1, g), u2);
+}
+
 /// Samples a new propagation direction around `d`, with the phase function's value there.
 inline PhaseSample hg_sample(const Vec3& d, double g, double u1, double u2) {
-  return {hg_sample_direction(d, g, u1, u2), hg_eval(hg_sample_cos(u1, g), g)};
+  const double cos_t = hg_sample_cos(u1, g);
+  return {direction_around(d, cos_t, u2), hg_eval(cos_t, g)};
 }
 
 }  // namespace femto
