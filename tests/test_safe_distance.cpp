@@ -146,7 +146,7 @@ TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
     int per_axis[3] = {0, 0, 0};
     for (int q = 0; q < ref.count; ++q) ++per_axis[ref.axis[q]];
     const bool single = per_axis[0] <= 1 && per_axis[1] <= 1 && per_axis[2] <= 1;
-    if (!crossings_closed_form(v, p, s_stop, end, got)) {
+    if (!crossings_closed_form(v, p.x, p.d, p.cell, s_stop, end, got)) {
       ++declined;
       CHECK_FALSE(single);
       continue;

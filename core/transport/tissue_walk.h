@@ -158,22 +158,23 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
 /// march's unpredictable choice of the next axis: the up to three face distances are sorted by a
 /// fixed network. Every voxel on the way must have p's label (a safe box). Returns false, with
 /// nothing written, when an axis has two or more faces before s_stop (the march's case).
-inline bool crossings_closed_form(const LabelVolume& vol, const Photon& p, double s_stop,
-                                  int end_cell[3], VoxelCrossings& crossed) {
+inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const Vec3& dir,
+                                  const int cell[3], double s_stop, int end_cell[3],
+                                  VoxelCrossings& crossed) {
   double t[3];
   bool cross[3];
   bool single = true;
   for (int a = 0; a < 3; ++a) {
-    const double d = p.d[a];
+    const double d = dir[a];
     const bool up = d > 0;
-    const double face = vol.origin[a] + (p.cell[a] + (up ? 1 : 0)) * vol.voxel;
+    const double face = vol.origin[a] + (cell[a] + (up ? 1 : 0)) * vol.voxel;
     const double inv_d = 1 / d;  // one division per axis
-    const double ta = d != 0 ? std::max(0.0, (face - p.x[a]) * inv_d) : kInf;
+    const double ta = d != 0 ? std::max(0.0, (face - x[a]) * inv_d) : kInf;
     const double delta = d != 0 ? vol.voxel * std::abs(inv_d) : kInf;
     cross[a] = ta < s_stop;
     single &= !(ta + delta < s_stop);
     t[a] = cross[a] ? ta : kInf;
-    end_cell[a] = p.cell[a] + (cross[a] ? (up ? 1 : -1) : 0);
+    end_cell[a] = cell[a] + (cross[a] ? (up ? 1 : -1) : 0);
   }
   if (!single) return false;
   // Sort (t, axis) by t: three compare-exchanges; ties keep the lower axis first.
@@ -260,7 +261,7 @@ class LabelSpace {
     const int safe = safe_[vol_.index(p.cell[0], p.cell[1], p.cell[2])];
     const Vec3 x1 = p.x + p.d * s_stop;
     if (inside_safe_box(vol_, p.cell, safe, x1, margin_)) {
-      if (crossed && crossings_closed_form(vol_, p, s_stop, end_cell, *crossed))
+      if (crossed && crossings_closed_form(vol_, p.x, p.d, p.cell, s_stop, end_cell, *crossed))
         return std::numeric_limits<double>::infinity();
       if (crossed)  // the faces for a tally; every neighbour has the label
         return march_to_change(vol_, p, s_stop, axis, end_cell, crossed,
