@@ -178,18 +178,6 @@ class Tally {
     }
   }
 
-  // Integral of exp(-mu s) over a piece of length ds, divided by ds: (1 - e^-x) / x with
-  // x = mu ds, and e^-x itself (a series for small x: no exponential per voxel).
-  static double mean_decay(double x, double& e) {
-    if (x < 0.01) {  // truncation below x^5 / 720 < 1.4e-13
-      const double g = 1 - x * (0.5 - x * (1.0 / 6 - x * (1.0 / 24 - x * (1.0 / 120))));
-      e = 1 - x * g;
-      return g;
-    }
-    e = std::exp(-x);
-    return (1 - e) / x;
-  }
-
   // The integral of exp(-mu u) over u in [0, s], mu >= 0: s (1 - e^-x) / x with x = mu s; a
   // series for x < 0.05 (no exponential).
   static double decay_integral(double mu, double s) {
@@ -200,8 +188,9 @@ class Tally {
 
   void fluence(const Segment& seg) {
     if (same_grid_) {
-      // The label grid's voxels along the segment; the weight factor exp(-mu_a s) is carried
-      // from voxel to voxel.
+      // The label grid's voxels along the segment; a piece [sa, sb] inside one gate gets
+      // w0 (F(sb) - F(sa)), F = decay_integral: each boundary's F on its own, so the pieces do
+      // not wait for one another.
       const double L = seg.distance, mu = seg.mu;
       // The gate the walk is in (it stops at gate ends): no division to find it.
       const bool one_gate = seg.t0 >= gate_lo_ && seg.t0 + seg.duration <= gate_hi_;
@@ -209,8 +198,7 @@ class Tally {
       const VoxelCrossings* vc = seg.crossings;
       if (one_gate && vc && vc->complete()) {
         // The faces the walk crossed, all pieces in one gate (most segments: the walk stops at
-        // gate ends). A piece [sa, sb] gets w0 (F(sb) - F(sa)): each boundary's F on its own, so
-        // the pieces do not wait for one another.
+        // gate ends).
         const int step[3] = {seg.d[0] > 0 ? 1 : -1, seg.d[1] > 0 ? 1 : -1, seg.d[2] > 0 ? 1 : -1};
         int c[3] = {seg.cell[0], seg.cell[1], seg.cell[2]};
         double sa = 0, Fa = 0;
@@ -223,18 +211,16 @@ class Tally {
         }
         return;
       }
-      double sa = 0, ea = 1;
+      double sa = 0, Fa = 0;
       auto piece = [&](int cx, int cy, int cz, double sb) {
         if (!(sb > sa)) return;
         const size_t c = layout_.index(cx, cy, cz);
         if (one_gate) {
-          double e;
-          const double g = mean_decay(mu * (sb - sa), e);
-          add(c + gate_offset, seg.w0 * ea * (sb - sa) * g);
-          ea *= e;
+          const double Fb = decay_integral(mu, sb);
+          add(c + gate_offset, seg.w0 * (Fb - Fa));
+          Fa = Fb;
         } else {  // the segment crosses gates (or the window start): split exactly
           deposit(seg, c, sa / seg.v, sb / seg.v);
-          ea = mu > 0 ? std::exp(-mu * sb) : 1.0;
         }
         sa = sb;
       };
