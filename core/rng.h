@@ -48,6 +48,10 @@ class Rng {
     return static_cast<double>((hi << 26) | lo) * (1.0 / 9007199254740992.0);
   }
 
+  /// Uniform double in [0, 1) with 32 random bits, from one output (uniform() takes two): for
+  /// angles, where steps of 2^-32 are far below any tally's resolution.
+  double uniform32() { return static_cast<double>(next_u32()) * (1.0 / 4294967296.0); }
+
  private:
   uint64_t state_ = 0;
   uint64_t inc_ = 1;

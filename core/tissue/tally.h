@@ -26,10 +26,15 @@ struct BrickLayout {
     for (int a = 0; a < 3; ++a) nb[a] = (n[a] + 3) / 4;
     slots = static_cast<size_t>(nb[0]) * nb[1] * nb[2] * 64;
   }
-  size_t index(int i, int j, int k) const {
-    const size_t brick = (static_cast<size_t>(i >> 2) * nb[1] + (j >> 2)) * nb[2] + (k >> 2);
-    return brick * 64 + static_cast<size_t>(((i & 3) << 4) | ((j & 3) << 2) | (k & 3));
+  /// The slot is a sum of one term per axis (brick and place in the brick alike): a tally can
+  /// keep the terms in tables and move along an axis by changing one term.
+  size_t part(int axis, int c) const {
+    const size_t brick = static_cast<size_t>(c >> 2), in = static_cast<size_t>(c & 3);
+    if (axis == 0) return brick * static_cast<size_t>(nb[1]) * nb[2] * 64 + (in << 4);
+    if (axis == 1) return brick * static_cast<size_t>(nb[2]) * 64 + (in << 2);
+    return brick * 64 + in;
   }
+  size_t index(int i, int j, int k) const { return part(0, i) + part(1, j) + part(2, k); }
 };
 
 /// Integer sums of the volume tallies of one thread (fixed point: order-independent).
@@ -54,6 +59,8 @@ class Tally {
     cells_ = layout_.slots;
     plane_tolerance_ = 1e-6 * s.volume.voxel;
     queue_.resize(kQueue);
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < fg.n[a]; ++c) part_[static_cast<size_t>(a)].push_back(layout_.part(a, c));
   }
   /// A chunk of `photons` photons starts: their partial paths are 0 and no record is kept.
   void start_chunk(ChunkSums& out, size_t photons) {
@@ -78,7 +85,13 @@ class Tally {
     out_->absorbed[static_cast<size_t>(seg.label)] += seg.absorbed;
     out_->balance.absorbed += seg.absorbed;
     if (ppath_) ppath_[static_cast<size_t>(seg.label)] += seg.length();
-    if (s_.fluence && seg.duration > 0) fluence(seg);
+    if (!s_.fluence || !(seg.duration > 0)) return;
+    const VoxelCrossings* vc = seg.crossings;
+    // Most steps: in the gate the walk is in, with at most one voxel face per axis.
+    if (vc && vc->one_per_axis && seg.t0 >= gate_lo_ && seg.t0 + seg.duration <= gate_hi_)
+      fluence_one_per_axis(seg, *vc);
+    else
+      fluence(seg);
   }
 
   void escape(const Photon& p) {
@@ -178,15 +191,30 @@ class Tally {
     }
   }
 
-  // The integral of exp(-mu u) over u in [0, s], mu >= 0: s (1 - e^-x) / x with x = mu s; a
-  // series for x < 0.05 (no exponential).
-  static double decay_integral(double mu, double s) {
-    const double x = mu * s;
-    if (x < 0.05) return s * exp_mean_series(x);
-    return -std::expm1(-x) / mu;
+  // The pieces of a step inside one gate that crosses at most one voxel face per axis: the voxel
+  // after the face on axis a differs from the one before only in that axis's term of the slot,
+  // which becomes the end voxel's. A piece [sa, sb] gets w0 (F(sb) - F(sa)), F = decay_integral:
+  // each boundary's F on its own, so the pieces do not wait for one another.
+  void fluence_one_per_axis(const Segment& seg, const VoxelCrossings& vc) {
+    const int* c = seg.cell;
+    const int* e = seg.cell_end;
+    const size_t* px = part_[0].data();
+    const size_t* py = part_[1].data();
+    const size_t* pz = part_[2].data();
+    size_t slot = gate_offset_ + px[c[0]] + py[c[1]] + pz[c[2]];
+    // Unsigned wrap-around: adding the difference of two terms moves the slot either way.
+    const size_t move[3] = {px[e[0]] - px[c[0]], py[e[1]] - py[c[1]], pz[e[2]] - pz[c[2]]};
+    double Fa = 0;
+    for (int q = 0; q < vc.count; ++q) {
+      const double Fb = decay_integral(seg.mu, vc.s[q]);
+      add(slot, seg.w0 * (Fb - Fa));  // a piece of length 0 (a corner) adds 0
+      Fa = Fb;
+      slot += move[vc.axis[q]];
+    }
+    add(slot, seg.w0 * (seg.decay - Fa));
   }
 
-  void fluence(const Segment& seg) {
+  [[gnu::noinline]] void fluence(const Segment& seg) {
     if (same_grid_) {
       // The label grid's voxels along the segment; a piece [sa, sb] inside one gate gets
       // w0 (F(sb) - F(sa)), F = decay_integral: each boundary's F on its own, so the pieces do
@@ -358,6 +386,7 @@ class Tally {
   size_t slot_ = 0;                      // this photon's place in the chunk
   std::vector<uint32_t> record_photon_;  // per record: its photon's place in the chunk
   VoxelCrossings crossings_;             // the faces of the current step, from the walk
+  std::array<std::vector<size_t>, 3> part_;  // BrickLayout::part per axis and voxel coordinate
   ChunkSums* out_ = nullptr;
 };
 

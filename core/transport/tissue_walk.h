@@ -118,7 +118,7 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
   const ptrdiff_t sy = dda.step[1] * static_cast<ptrdiff_t>(vol.n[2]), sz = dda.step[2];
   ptrdiff_t i = static_cast<ptrdiff_t>(vol.index(cx, cy, cz));  // a tissue voxel: in the grid
   double s = std::numeric_limits<double>::infinity();
-  if (crossed) crossed->count = 0;
+  if (crossed) crossed->count = 0, crossed->one_per_axis = false;
   while (true) {
     if (tx < ty && tx < tz) {  // the same choice as VoxelDda::axis()
       if (tx >= s_stop) break;
@@ -190,6 +190,7 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
   const int count = int{cross[0]} + int{cross[1]} + int{cross[2]};
   for (int q = 0; q < 3; ++q) crossed.s[q] = t[q], crossed.axis[q] = static_cast<int8_t>(ax[q]);
   crossed.count = count;
+  crossed.one_per_axis = true;
   return true;
 }
 
@@ -314,6 +315,14 @@ inline double one_minus_exp(double x) {
   return 1 - std::exp(-x);
 }
 
+/// The integral of exp(-mu u) over u in [0, s], mu >= 0: s (1 - e^-x) / x with x = mu s; a
+/// series for x < 0.05 (no exponential).
+inline double decay_integral(double mu, double s) {
+  const double x = mu * s;
+  if (x < 0.05) return s * exp_mean_series(x);
+  return -std::expm1(-x) / mu;
+}
+
 /// One step of the walk: moves p along a straight piece, fills `seg` with it (weight, absorbed
 /// energy, time, label and voxel) and returns what ended it.
 template <class Space>
@@ -341,6 +350,7 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   seg.mu = analog ? 0.0 : o.mu_a;
   seg.scatterings = p.scatterings, seg.label = p.label;
   seg.cell[0] = p.cell[0], seg.cell[1] = p.cell[1], seg.cell[2] = p.cell[2];
+  seg.cell_end[0] = end_cell[0], seg.cell_end[1] = end_cell[1], seg.cell_end[2] = end_cell[2];
   seg.duration = s * o.inv_v;
   seg.distance = s;
   if (!std::isfinite(s)) {  // an endless flight: everything is absorbed on the way (if mu_a > 0)
@@ -350,8 +360,9 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
     p.t = kInf;
     return StepEvent::Lost;
   }
-  const double x = seg.mu * s;  // k duration
-  seg.absorbed = x > 0 ? p.w * one_minus_exp(x) : 0.0;
+  // 1 - exp(-mu s) = mu F(s): the tally's fluence takes F(s) too.
+  seg.decay = decay_integral(seg.mu, s);
+  seg.absorbed = p.w * (seg.mu * seg.decay);
   p.w -= seg.absorbed;  // absorbed + carried = w0 exactly, up to one rounding
   p.x += p.d * s;
   p.cell[0] = end_cell[0], p.cell[1] = end_cell[1], p.cell[2] = end_cell[2];
@@ -373,7 +384,7 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
     p.alive = false;
     return StepEvent::Absorbed;
   }
-  p.d = hg_sample_direction(p.d, o.g, rng.uniform(), rng.uniform());
+  p.d = hg_sample_direction(p.d, o.g, rng.uniform32(), rng.uniform32());
   ++p.scatterings;
   return StepEvent::Scattered;
 }
