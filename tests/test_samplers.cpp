@@ -19,6 +19,7 @@
 #include "core/vec3.h"
 #include "media/phase_hg.h"
 #include "samplers/distance.h"
+#include "samplers/exponential_ziggurat.h"
 #include "samplers/stats.h"
 
 using femto::kPi;
@@ -190,6 +191,62 @@ TEST_CASE("Exponential distance sampling matches exponential_pdf", "[samplers][d
     INFO("sigma_t = " << sigma_t << "  chi2 = " << r.chi2 << "  dof = " << r.dof
                       << "  p = " << r.p_value);
     CHECK(r.p_value >= kSamplerAlpha);
+  }
+}
+
+// Catches a wrong ziggurat table (a layer whose area is not the others', edges that do not reach
+// the top of the curve), a wedge test that accepts too much or too little (excess or deficit
+// between the layers' inner edges), and a wrong tail beyond r (e.g. r + u instead of r + Exp).
+TEST_CASE("Ziggurat exponential variates match exp(-x)", "[samplers][distance]") {
+  const femto::ExpZiggurat& z = femto::ExpZiggurat::get();
+  const double A = z.area();
+  CHECK(z.edge(0) * z.height(1) == Approx(A).epsilon(1e-13));  // base rectangle + tail
+  for (int i = 1; i < femto::ExpZiggurat::kLayers; ++i) {
+    INFO("layer " << i);
+    CHECK(z.edge(i) * (z.height(i + 1) - z.height(i)) == Approx(A).epsilon(1e-9));
+    CHECK(z.edge(i + 1) < z.edge(i));
+  }
+  // Whole range: 300 bins of 0.04 up to 12 and an overflow bin.
+  {
+    const int bins = 300, n = 3000000;
+    const double h = 0.04;
+    std::vector<double> observed(bins + 1, 0.0), expected(bins + 1, 0.0);
+    Rng rng(21, 3);
+    int invalid = 0;
+    for (int k = 0; k < n; ++k) {
+      const double x = femto::sample_unit_exponential(rng);
+      if (!(x >= 0.0 && std::isfinite(x))) {
+        ++invalid;
+        continue;
+      }
+      observed[x >= bins * h ? bins : static_cast<int>(x / h)] += 1.0;
+    }
+    for (int i = 0; i < bins; ++i) expected[i] = n * (std::exp(-i * h) - std::exp(-(i + 1) * h));
+    expected[bins] = n * std::exp(-bins * h);
+    CHECK(invalid == 0);
+    const st::Chi2Result r = st::chi2_test(observed, expected);
+    INFO("chi2 = " << r.chi2 << "  dof = " << r.dof << "  p = " << r.p_value);
+    CHECK(r.p_value >= kSamplerAlpha);
+  }
+  // Beyond r (the tail, drawn from the base layer): x - r must be exponential again.
+  {
+    const double r = z.edge(1);
+    const int bins = 40, want = 20000;
+    const double h = 0.1;
+    std::vector<double> observed(bins + 1, 0.0), expected(bins + 1, 0.0);
+    Rng rng(22, 3);
+    for (int got = 0; got < want;) {
+      const double x = femto::sample_unit_exponential(rng);
+      if (x < r) continue;
+      const double y = x - r;
+      observed[y >= bins * h ? bins : static_cast<int>(y / h)] += 1.0;
+      ++got;
+    }
+    for (int i = 0; i < bins; ++i) expected[i] = want * (std::exp(-i * h) - std::exp(-(i + 1) * h));
+    expected[bins] = want * std::exp(-bins * h);
+    const st::Chi2Result t = st::chi2_test(observed, expected);
+    INFO("tail: chi2 = " << t.chi2 << "  dof = " << t.dof << "  p = " << t.p_value);
+    CHECK(t.p_value >= kSamplerAlpha);
   }
 }
 

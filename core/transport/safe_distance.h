@@ -21,12 +21,15 @@ inline bool inside_safe_box(const LabelVolume& vol, const int cell[3], int safe,
                             double margin) {
   if (safe <= 0) return false;
   const double h = vol.voxel;
+  // Plain arrays: Vec3's operator[] is a chain of selects where a loop is not unrolled.
+  const double o[3] = {vol.origin.x, vol.origin.y, vol.origin.z}, e[3] = {x1.x, x1.y, x1.z};
+  const double below = (safe - 1) * h - margin, above = safe * h - margin;
+  bool inside = true;
   for (int a = 0; a < 3; ++a) {
-    const double lo = vol.origin[a] + (cell[a] - (safe - 1)) * h + margin;
-    const double hi = vol.origin[a] + (cell[a] + safe) * h - margin;
-    if (!(x1[a] > lo && x1[a] < hi)) return false;  // NaN and inf fail too
+    const double corner = o[a] + cell[a] * h;                  // the voxel's lower corner
+    inside &= e[a] > corner - below && e[a] < corner + above;  // NaN and inf fail too
   }
-  return true;
+  return inside;
 }
 
 }  // namespace femto

@@ -17,6 +17,7 @@
 #include "core/transport/safe_distance.h"
 #include "core/transport/tissue_volume.h"
 #include "media/phase_hg.h"
+#include "samplers/exponential_ziggurat.h"
 
 namespace femto {
 
@@ -164,13 +165,17 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
   double t[3];
   bool cross[3];
   bool single = true;
+  // Plain arrays: Vec3's operator[] is a chain of selects where a loop is not unrolled.
+  const double o[3] = {vol.origin.x, vol.origin.y, vol.origin.z}, xs[3] = {x.x, x.y, x.z},
+               ds[3] = {dir.x, dir.y, dir.z};
+  const double h = vol.voxel;
   for (int a = 0; a < 3; ++a) {
-    const double d = dir[a];
+    const double d = ds[a];
     const bool up = d > 0;
-    const double face = vol.origin[a] + (cell[a] + (up ? 1 : 0)) * vol.voxel;
+    const double face = o[a] + (cell[a] + (up ? 1 : 0)) * h;  // as the march computes it
     const double inv_d = 1 / d;  // one division per axis
-    const double ta = d != 0 ? std::max(0.0, (face - x[a]) * inv_d) : kInf;
-    const double delta = d != 0 ? vol.voxel * std::abs(inv_d) : kInf;
+    const double ta = d != 0 ? std::max(0.0, (face - xs[a]) * inv_d) : kInf;
+    const double delta = d != 0 ? h * std::abs(inv_d) : kInf;
     cross[a] = ta < s_stop;
     single &= !(ta + delta < s_stop);
     t[a] = cross[a] ? ta : kInf;
@@ -330,7 +335,7 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   const auto& o = space.optics_at(p);  // a reference, or a voxel's optics by value
   const bool analog = ws.absorption == Absorption::Analog;
   const double rate = analog ? o.mu_t : o.mu_s;
-  if (p.tau_left < 0) p.tau_left = -std::log(1 - rng.uniform());  // 1 - u is exact
+  if (p.tau_left < 0) p.tau_left = sample_unit_exponential(rng);
   int axis = 0, end_cell[3];
   const double s_event = rate > 0 ? p.tau_left * (analog ? o.inv_mu_t : o.inv_mu_s) : kInf;
   const double s_window = (ws.t_end - p.t) * o.v;
