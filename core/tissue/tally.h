@@ -225,18 +225,24 @@ class Tally {
       const size_t gate_offset = one_gate ? gate_offset_ : 0;
       const VoxelCrossings* vc = seg.crossings;
       if (one_gate && vc && vc->complete()) {
-        // The faces the walk crossed, all pieces in one gate (most segments: the walk stops at
-        // gate ends).
+        // The faces the walk's march crossed, all pieces in one gate: the slot moves by one
+        // axis's term per face (as in fluence_one_per_axis, with the voxel tracked).
         const int step[3] = {seg.d[0] > 0 ? 1 : -1, seg.d[1] > 0 ? 1 : -1, seg.d[2] > 0 ? 1 : -1};
         int c[3] = {seg.cell[0], seg.cell[1], seg.cell[2]};
-        double sa = 0, Fa = 0;
-        for (int q = 0; q <= vc->count; ++q) {
-          const double sb = q < vc->count ? vc->s[q] : L;
-          const double Fb = decay_integral(mu, sb);
-          if (sb > sa) add(gate_offset + layout_.index(c[0], c[1], c[2]), seg.w0 * (Fb - Fa));
-          sa = sb, Fa = Fb;
-          if (q < vc->count) c[vc->axis[q]] += step[vc->axis[q]];
+        size_t slot = gate_offset + part_[0][static_cast<size_t>(c[0])] +
+                      part_[1][static_cast<size_t>(c[1])] + part_[2][static_cast<size_t>(c[2])];
+        double Fa = 0;
+        for (int q = 0; q < vc->count; ++q) {
+          const double Fb = decay_integral(mu, vc->s[q]);
+          add(slot, seg.w0 * (Fb - Fa));  // a piece of length 0 (a corner) adds 0
+          Fa = Fb;
+          const int a = vc->axis[q];
+          const std::vector<size_t>& part = part_[static_cast<size_t>(a)];
+          const int next = c[a] + step[a];
+          slot += part[static_cast<size_t>(next)] - part[static_cast<size_t>(c[a])];
+          c[a] = next;
         }
+        add(slot, seg.w0 * (seg.decay - Fa));
         return;
       }
       double sa = 0, Fa = 0;
