@@ -63,7 +63,10 @@ struct VoxelDda {
   int cell[3] = {0, 0, 0}, step[3] = {0, 0, 0};
   double t_max[3] = {0, 0, 0}, t_delta[3] = {0, 0, 0};
 
-  VoxelDda(const Vec3& x, const Vec3& d, const int c[3], const Vec3& origin, const Vec3& h) {
+  VoxelDda(const Vec3& x_, const Vec3& d_, const int c[3], const Vec3& origin_, const Vec3& h_) {
+    // Plain arrays: Vec3's operator[] is a chain of selects where a loop is not unrolled.
+    const double x[3] = {x_.x, x_.y, x_.z}, d[3] = {d_.x, d_.y, d_.z};
+    const double origin[3] = {origin_.x, origin_.y, origin_.z}, h[3] = {h_.x, h_.y, h_.z};
     for (int a = 0; a < 3; ++a) {
       cell[a] = c[a];
       if (d[a] == 0) {
@@ -162,6 +165,7 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
 inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const Vec3& dir,
                                   const int cell[3], double s_stop, int end_cell[3],
                                   VoxelCrossings& crossed) {
+  static constexpr double kBeyond[2] = {kInf, 0.0};  // added to a face distance: no face, a face
   double t[3];
   bool cross[3];
   bool single = true;
@@ -176,20 +180,22 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
     const double inv_d = 1 / d;  // one division per axis
     const double ta = d != 0 ? std::max(0.0, (face - xs[a]) * inv_d) : kInf;
     const double delta = d != 0 ? h * std::abs(inv_d) : kInf;
-    cross[a] = ta < s_stop;
+    // Whether an axis has a face is a coin flip for a branch predictor: no branch on it below.
+    const bool c = ta < s_stop;
+    cross[a] = c;
     single &= !(ta + delta < s_stop);
-    t[a] = cross[a] ? ta : kInf;
-    end_cell[a] = cell[a] + (cross[a] ? (up ? 1 : -1) : 0);
+    t[a] = ta + kBeyond[c];  // +inf sorts an axis without a face last
+    end_cell[a] = cell[a] + int{c} * (2 * int{up} - 1);
   }
   if (!single) return false;
-  // Sort (t, axis) by t: three compare-exchanges; ties keep the lower axis first.
+  // Sort (t, axis) by t: three compare-exchanges (min, max and an integer blend: no branch);
+  // ties keep the lower axis first.
   int ax[3] = {0, 1, 2};
   auto exchange = [&](int i, int j) {
-    const bool swap = t[j] < t[i];
     const double ti = t[i], tj = t[j];
-    const int ai = ax[i], aj = ax[j];
-    t[i] = swap ? tj : ti, t[j] = swap ? ti : tj;
-    ax[i] = swap ? aj : ai, ax[j] = swap ? ai : aj;
+    const int flip = (ax[i] ^ ax[j]) & -int{tj < ti};
+    t[i] = std::min(ti, tj), t[j] = std::max(tj, ti);  // (tj < ti ? tj : ti), (tj < ti ? ti : tj)
+    ax[i] ^= flip, ax[j] ^= flip;
   };
   exchange(0, 1), exchange(1, 2), exchange(0, 1);
   const int count = int{cross[0]} + int{cross[1]} + int{cross[2]};
