@@ -3,8 +3,8 @@
 // exp(-x) is covered by 256 layers of equal area, and a draw that lands inside a layer's part
 // under the curve (about 99% of draws) costs a table lookup and a comparison: no logarithm. The
 // rest take the exact wedge test or the exact tail, so the variates are exponential to the
-// resolution of the uniforms (2^-53 of a layer's width). For the photon walks, where the
-// logarithm of -log(1 - u) was a tenth of a step.
+// resolution of the uniforms (2^-53 of a layer's width). For the photon walks, where
+// -log(1 - u) was about a twentieth of a step's instructions.
 #include <cmath>
 #include <cstdint>
 
