@@ -87,9 +87,9 @@ class Tally {
     if (ppath_) ppath_[static_cast<size_t>(seg.label)] += seg.length();
     if (!s_.fluence || !(seg.duration > 0)) return;
     const VoxelCrossings* vc = seg.crossings;
-    // Most steps: in the gate the walk is in, with at most one voxel face per axis.
-    if (vc && vc->one_per_axis && seg.t0 >= gate_lo_ && seg.t0 + seg.duration <= gate_hi_)
-      fluence_one_per_axis(seg, *vc);
+    // Most steps: in the gate the walk is in, with the voxel faces the walk crossed.
+    if (vc && vc->complete() && seg.t0 >= gate_lo_ && seg.t0 + seg.duration <= gate_hi_)
+      fluence_faces(seg, *vc);
     else
       fluence(seg);
   }
@@ -191,25 +191,24 @@ class Tally {
     }
   }
 
-  // The pieces of a step inside one gate that crosses at most one voxel face per axis: the voxel
-  // after the face on axis a differs from the one before only in that axis's term of the slot,
-  // which becomes the end voxel's. A piece [sa, sb] gets w0 (F(sb) - F(sa)), F = decay_integral:
-  // each boundary's F on its own, so the pieces do not wait for one another.
-  void fluence_one_per_axis(const Segment& seg, const VoxelCrossings& vc) {
-    const int* c = seg.cell;
-    const int* e = seg.cell_end;
-    const size_t* px = part_[0].data();
-    const size_t* py = part_[1].data();
-    const size_t* pz = part_[2].data();
-    size_t slot = gate_offset_ + px[c[0]] + py[c[1]] + pz[c[2]];
-    // Unsigned wrap-around: adding the difference of two terms moves the slot either way.
-    const size_t move[3] = {px[e[0]] - px[c[0]], py[e[1]] - py[c[1]], pz[e[2]] - pz[c[2]]};
+  // The pieces of a step inside one gate, split at the voxel faces the walk crossed. A piece
+  // [sa, sb] gets w0 (F(sb) - F(sa)), F = decay_integral: each boundary's F on its own, so the
+  // pieces do not wait for one another. The slot moves by one axis's term per face.
+  void fluence_faces(const Segment& seg, const VoxelCrossings& vc) {
+    const int step[3] = {seg.d.x > 0 ? 1 : -1, seg.d.y > 0 ? 1 : -1, seg.d.z > 0 ? 1 : -1};
+    int c[3] = {seg.cell[0], seg.cell[1], seg.cell[2]};
+    size_t slot = gate_offset_ + part_[0][static_cast<size_t>(c[0])] +
+                  part_[1][static_cast<size_t>(c[1])] + part_[2][static_cast<size_t>(c[2])];
     double Fa = 0;
     for (int q = 0; q < vc.count; ++q) {
       const double Fb = decay_integral(seg.mu, vc.s[q]);
       add(slot, seg.w0 * (Fb - Fa));  // a piece of length 0 (a corner) adds 0
       Fa = Fb;
-      slot += move[vc.axis[q]];
+      const int a = vc.axis[q];
+      const size_t* part = part_[static_cast<size_t>(a)].data();
+      const int next = c[a] + step[a];
+      slot += part[next] - part[c[a]];  // unsigned wrap-around moves the slot either way
+      c[a] = next;
     }
     add(slot, seg.w0 * (seg.decay - Fa));
   }
@@ -224,27 +223,6 @@ class Tally {
       const bool one_gate = seg.t0 >= gate_lo_ && seg.t0 + seg.duration <= gate_hi_;
       const size_t gate_offset = one_gate ? gate_offset_ : 0;
       const VoxelCrossings* vc = seg.crossings;
-      if (one_gate && vc && vc->complete()) {
-        // The faces the walk's march crossed, all pieces in one gate: the slot moves by one
-        // axis's term per face (as in fluence_one_per_axis, with the voxel tracked).
-        const int step[3] = {seg.d[0] > 0 ? 1 : -1, seg.d[1] > 0 ? 1 : -1, seg.d[2] > 0 ? 1 : -1};
-        int c[3] = {seg.cell[0], seg.cell[1], seg.cell[2]};
-        size_t slot = gate_offset + part_[0][static_cast<size_t>(c[0])] +
-                      part_[1][static_cast<size_t>(c[1])] + part_[2][static_cast<size_t>(c[2])];
-        double Fa = 0;
-        for (int q = 0; q < vc->count; ++q) {
-          const double Fb = decay_integral(mu, vc->s[q]);
-          add(slot, seg.w0 * (Fb - Fa));  // a piece of length 0 (a corner) adds 0
-          Fa = Fb;
-          const int a = vc->axis[q];
-          const std::vector<size_t>& part = part_[static_cast<size_t>(a)];
-          const int next = c[a] + step[a];
-          slot += part[static_cast<size_t>(next)] - part[static_cast<size_t>(c[a])];
-          c[a] = next;
-        }
-        add(slot, seg.w0 * (seg.decay - Fa));
-        return;
-      }
       double sa = 0, Fa = 0;
       auto piece = [&](int cx, int cy, int cz, double sb) {
         if (!(sb > sa)) return;

@@ -29,9 +29,6 @@ struct Photon {
 struct VoxelCrossings {
   static constexpr int kMax = 64;
   int count = 0;  ///< faces crossed; above kMax only the first kMax are recorded
-  /// At most one face per axis (crossings_closed_form): the voxel after the face on axis a has
-  /// the step's end voxel's coordinate on a.
-  bool one_per_axis = false;
   double s[kMax];
   int8_t axis[kMax];
   bool complete() const { return count <= kMax; }
@@ -58,7 +55,6 @@ struct Segment {
   double distance = 0;      ///< geometric length, mm (tissue walk; v * duration up to rounding)
   int label = 0;            ///< label of the region crossed (tissue walk: one label, many voxels)
   int cell[3] = {0, 0, 0};  ///< voxel of the start (tissue walk)
-  int cell_end[3] = {0, 0, 0};  ///< voxel of the end, this side of a face that ends it
   /// Set by the caller (or nullptr): the walk records there the voxel faces crossed in the step.
   VoxelCrossings* crossings = nullptr;
   double length() const { return distance; }

@@ -122,7 +122,7 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
   const ptrdiff_t sy = dda.step[1] * static_cast<ptrdiff_t>(vol.n[2]), sz = dda.step[2];
   ptrdiff_t i = static_cast<ptrdiff_t>(vol.index(cx, cy, cz));  // a tissue voxel: in the grid
   double s = std::numeric_limits<double>::infinity();
-  if (crossed) crossed->count = 0, crossed->one_per_axis = false;
+  if (crossed) crossed->count = 0;
   while (true) {
     if (tx < ty && tx < tz) {  // the same choice as VoxelDda::axis()
       if (tx >= s_stop) break;
@@ -201,7 +201,6 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
   const int count = int{cross[0]} + int{cross[1]} + int{cross[2]};
   for (int q = 0; q < 3; ++q) crossed.s[q] = t[q], crossed.axis[q] = static_cast<int8_t>(ax[q]);
   crossed.count = count;
-  crossed.one_per_axis = true;
   return true;
 }
 
@@ -361,7 +360,6 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   seg.mu = analog ? 0.0 : o.mu_a;
   seg.scatterings = p.scatterings, seg.label = p.label;
   seg.cell[0] = p.cell[0], seg.cell[1] = p.cell[1], seg.cell[2] = p.cell[2];
-  seg.cell_end[0] = end_cell[0], seg.cell_end[1] = end_cell[1], seg.cell_end[2] = end_cell[2];
   seg.duration = s * o.inv_v;
   seg.distance = s;
   if (!std::isfinite(s)) {  // an endless flight: everything is absorbed on the way (if mu_a > 0)
