@@ -62,12 +62,14 @@ class ExpZiggurat {
   }
 
   double r_ = 0, area_ = 0;
-  double x_[kLayers + 1] = {};      // layer i spans [0, x_i] x [f_i, f_{i+1}]
-  double f_[kLayers + 1] = {};      // exp(-x_i)
-  double width_[kLayers] = {};      // x_i / 2^53: a 53-bit integer times it is u x_i
+  double x_[kLayers + 1] = {};  // layer i spans [0, x_i] x [f_i, f_{i+1}]
+  double f_[kLayers + 1] = {};  // exp(-x_i)
+  double width_[kLayers] = {};  // x_i / 2^53: a 53-bit integer times it is u x_i
 };
 
 /// A unit-mean exponential variate (the optical depth to the next event of a photon walk).
-inline double sample_unit_exponential(Rng& rng) { return ExpZiggurat::get().sample(rng); }
+inline double sample_unit_exponential(Rng& rng) {
+  return ExpZiggurat::get().sample(rng);
+}
 
 }  // namespace femto
