@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# femto's cube60 benchmark against the established tissue Monte Carlo codes on the same machine,
+# interleaved round by round (docs/PERFORMANCE.md, "Against MMC and MCX-CL on the same host").
+# The other codes are not part of femto: build them yourself (commands below) and pass their
+# binaries. Each round runs femto-bench-tissue (1 and 2 threads), then MMC and MCX-CL with 1 and
+# 2 threads, all on 1e6 photons, and prints photons/ms as each program reports it (MMC and
+# MCX-CL: their "speed" line, which leaves out setup, kernel compilation and output).
+#
+#   git clone https://github.com/fangq/mmc && (cd mmc/src && make ssemath)      # CPU, SSE+OpenMP
+#   apt-get install pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers
+#   git clone https://github.com/fangq/mcxcl && (cd mcxcl/src && make)         # OpenCL on POCL
+#   bench/reference/run.sh build/femto-bench-tissue mmc/bin/mmc mcxcl/bin/mcxcl [ROUNDS]
+#
+# Run from the source root. Pass "-" for a code you do not have.
+set -eu
+femto=$1 mmc=$2 mcxcl=$3 rounds=${4:-3}
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+root=$(pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cp "$here/mmc_cube60.json" "$here/mcxcl_cube60.json" "$work/"
+echo "CPU: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; load $(cut -d' ' -f1-3 /proc/loadavg)"
+strip() { sed 's/\x1b\[[0-9;]*m//g'; }
+for r in $(seq "$rounds"); do
+  # femto: the bench's 1- and 2-thread rows (photons/ms wall clock, the absorbed fraction).
+  "$femto" "$root/data/scenes/cube60.json" 1e6 > "$work/femto" 2>&1
+  awk -v r="$r" 'NF == 9 && $1 ~ /^[12]$/ {printf "round %s femto  threads %s  %7.1f photons/ms  absorbed %s\n", r, $1, $2, $9}' "$work/femto"
+  for t in 1 2; do
+    if [ "$mmc" != - ]; then
+      (cd "$work" && OMP_NUM_THREADS=$t "$mmc" -f mmc_cube60.json -c sse -M G -n 1e6 -b 0 -O F -F bin \
+          -D T -s mmc_out > mmc.log 2>&1)
+      printf "round %s mmc    threads %s  %7.1f photons/ms  absorbed %s\n" "$r" "$t" \
+        "$(strip < "$work/mmc.log" | sed -n 's/.*speed[^0-9]*\([0-9.]*\) photon\/ms.*/\1/p' | head -1)" \
+        "$(strip < "$work/mmc.log" | sed -n 's/.*absorbed: *\([0-9.]*%\).*/\1/p' | head -1)"
+    fi
+    if [ "$mcxcl" != - ]; then
+      (cd "$work" && POCL_MAX_PTHREAD_COUNT=$t "$mcxcl" -f mcxcl_cube60.json -n 1e6 -b 0 -O F -F mc2 \
+          -G 1 -A 1 -s mcxcl_out > mcxcl.log 2>&1)
+      printf "round %s mcxcl  threads %s  %7.1f photons/ms  absorbed %s\n" "$r" "$t" \
+        "$(strip < "$work/mcxcl.log" | sed -n 's/.*speed[^0-9]*\([0-9.]*\) photon\/ms.*/\1/p' | head -1)" \
+        "$(strip < "$work/mcxcl.log" | sed -n 's/.*absorbed: *\([0-9.]*%\).*/\1/p' | head -1)"
+    fi
+  done
+done
