@@ -10,6 +10,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/branchless.h"
 #include "core/bsdf/fresnel.h"
 #include "core/constants.h"
 #include "core/rng.h"
@@ -73,9 +74,10 @@ struct VoxelDda {
         step[a] = 0, t_max[a] = kInf, t_delta[a] = kInf;
         continue;
       }
-      step[a] = d[a] > 0 ? 1 : -1;
-      const double face = origin[a] + (c[a] + (d[a] > 0 ? 1 : 0)) * h[a];
-      t_max[a] = std::max(0.0, (face - x[a]) / d[a]);
+      const int up = d[a] > 0;  // an integer, not a branch: the sign is a coin flip
+      step[a] = 2 * up - 1;
+      const double face = origin[a] + (c[a] + up) * h[a];
+      t_max[a] = select_max(0.0, (face - x[a]) / d[a]);
       t_delta[a] = h[a] / std::abs(d[a]);
     }
   }
@@ -178,7 +180,7 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
     const bool up = d > 0;
     const double face = o[a] + (cell[a] + (up ? 1 : 0)) * h;  // as the march computes it
     const double inv_d = 1 / d;  // one division per axis
-    const double ta = d != 0 ? std::max(0.0, (face - xs[a]) * inv_d) : kInf;
+    const double ta = d != 0 ? select_max(0.0, (face - xs[a]) * inv_d) : kInf;
     const double delta = d != 0 ? h * std::abs(inv_d) : kInf;
     // Whether an axis has a face is a coin flip for a branch predictor: no branch on it below.
     const bool c = ta < s_stop;
@@ -188,13 +190,14 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
     end_cell[a] = cell[a] + int{c} * (2 * int{up} - 1);
   }
   if (!single) return false;
-  // Sort (t, axis) by t: three compare-exchanges (min, max and an integer blend: no branch);
-  // ties keep the lower axis first.
+  // Sort (t, axis) by t: three compare-exchanges (minsd, maxsd and an integer blend: no branch,
+  // where std::min and std::max became jumps); ties keep the lower axis first.
   int ax[3] = {0, 1, 2};
   auto exchange = [&](int i, int j) {
     const double ti = t[i], tj = t[j];
     const int flip = (ax[i] ^ ax[j]) & -int{tj < ti};
-    t[i] = std::min(ti, tj), t[j] = std::max(tj, ti);  // (tj < ti ? tj : ti), (tj < ti ? ti : tj)
+    t[i] = select_min(ti, tj),
+    t[j] = select_max(tj, ti);  // (tj < ti ? tj : ti), (tj < ti ? ti : tj)
     ax[i] ^= flip, ax[j] ^= flip;
   };
   exchange(0, 1), exchange(1, 2), exchange(0, 1);
