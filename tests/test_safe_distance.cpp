@@ -116,7 +116,8 @@ TEST_CASE("the walk's safe boxes give the distance to the next label of a plain 
 
 TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
   // The fluence tally takes a step's voxel faces from crossings_closed_form where each axis has
-  // at most one face. Catches a face on the wrong side of the voxel, a wrong order of faces
+  // at most one face, and from crossings_in_safe_box (which must equal the march exactly:
+  // catches a wrong tie rule or axis choice) for the other steps inside a safe box. Catches a face on the wrong side of the voxel, a wrong order of faces
   // (a deposit into a voxel the step never enters), a step that crosses two faces on one axis
   // taken as closed-form (a face missed), and an end voxel out of step with the march.
   LabelVolume v;
@@ -126,7 +127,7 @@ TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
   v.labels.assign(v.cells(), 1);
   v.optics.assign(2, TissueOptics{0.01, 1.0, 0.0, 1.0});
   Rng rng(11, 5);
-  int closed = 0, declined = 0, with_faces = 0;
+  int closed = 0, declined = 0, with_faces = 0, in_grid = 0;
   for (int n = 0; n < 50000; ++n) {
     Photon p;
     p.label = 1;
@@ -140,9 +141,22 @@ TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
     p.d = Vec3(r * std::cos(phi), r * std::sin(phi), z);
     if (n % 50 == 1) p.d = Vec3(0, n % 100 == 1 ? 1.0 : -1.0, 0);        // along an axis
     const double s_stop = -std::log(1 - rng.uniform()) * v.voxel * 0.9;  // within 3 voxels
-    VoxelCrossings ref, got;
-    int axis = -1, end_ref[3], end[3];
-    march_to_change(v, p, s_stop, axis, end_ref, &ref, [](ptrdiff_t) { return true; });
+    VoxelCrossings ref, got, safe;
+    int axis = -1, end_ref[3], end[3], end_safe[3];
+    const double s_edge =
+        march_to_change(v, p, s_stop, axis, end_ref, &ref, [](ptrdiff_t) { return true; });
+    // The branch-free march of safe boxes: the same faces, distances and order, bit for bit
+    // (where the step stays in the grid, as it does inside a safe box).
+    if (std::isinf(s_edge)) {
+      ++in_grid;
+      crossings_in_safe_box(v, p, s_stop, end_safe, safe);
+      REQUIRE(safe.count == ref.count);
+      for (int q = 0; q < ref.count; ++q) {
+        CHECK(safe.s[q] == ref.s[q]);
+        CHECK(safe.axis[q] == ref.axis[q]);
+      }
+      for (int a = 0; a < 3; ++a) CHECK(end_safe[a] == end_ref[a]);
+    }
     int per_axis[3] = {0, 0, 0};
     for (int q = 0; q < ref.count; ++q) ++per_axis[ref.axis[q]];
     const bool single = per_axis[0] <= 1 && per_axis[1] <= 1 && per_axis[2] <= 1;
@@ -166,5 +180,6 @@ TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
   }
   CHECK(closed > 35000);
   CHECK(declined > 1000);
+  CHECK(in_grid > 45000);
   CHECK(with_faces > 20000);
 }

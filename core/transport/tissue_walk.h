@@ -207,6 +207,34 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
   return true;
 }
 
+/// The voxel faces crossed by the piece p.x + p.d s, s in [0, s_stop), when every voxel on the
+/// way has p's label (inside its safe box): the march's faces, in its order and at its
+/// distances, but the next axis is chosen by compares and selects, not by branches (for a
+/// predictor the choice is a coin flip, missed about once per face). For the steps that
+/// crossings_closed_form declines (two or more faces on an axis).
+inline void crossings_in_safe_box(const LabelVolume& vol, const Photon& p, double s_stop,
+                                  int end_cell[3], VoxelCrossings& crossed) {
+  const VoxelDda dda(p.x, p.d, p.cell, vol.origin, Vec3(vol.voxel));
+  double t[3] = {dda.t_max[0], dda.t_max[1], dda.t_max[2]};
+  int c[3] = {dda.cell[0], dda.cell[1], dda.cell[2]};
+  int count = 0;
+  while (true) {
+    const double tx = t[0], ty = t[1], tz = t[2];
+    // VoxelDda::axis(): x if tx < ty and tx < tz, else y if ty < tz (and not tx < ty), else z.
+    const int x_first = int{tx < ty} & int{tx < tz};
+    const int y_first = int{!(tx < ty)} & int{ty < tz};
+    const int a = 2 - 2 * x_first - y_first;
+    const double s = select_min(select_min(tx, ty), tz);  // t[a]: ties have one value
+    if (s >= s_stop) break;
+    if (count < VoxelCrossings::kMax) crossed.s[count] = s, crossed.axis[count] = int8_t(a);
+    ++count;
+    t[a] += dda.t_delta[a];
+    c[a] += dda.step[a];
+  }
+  crossed.count = count;
+  end_cell[0] = c[0], end_cell[1] = c[1], end_cell[2] = c[2];
+}
+
 /// Puts p exactly on the face of its voxel on `axis` that it moves towards (no drift) and gives
 /// the voxel beyond that face.
 inline void face_neighbour(const LabelVolume& vol, Photon& p, int axis, int next[3]) {
@@ -277,9 +305,10 @@ class LabelSpace {
     if (inside_safe_box(vol_, p.cell, safe, x1, margin_)) {
       if (crossed && crossings_closed_form(vol_, p.x, p.d, p.cell, s_stop, end_cell, *crossed))
         return std::numeric_limits<double>::infinity();
-      if (crossed)  // the faces for a tally; every neighbour has the label
-        return march_to_change(vol_, p, s_stop, axis, end_cell, crossed,
-                               [](ptrdiff_t) { return true; });
+      if (crossed) {  // the faces for a tally; every voxel on the way has the label
+        crossings_in_safe_box(vol_, p, s_stop, end_cell, *crossed);
+        return std::numeric_limits<double>::infinity();
+      }
       for (int a = 0; a < 3; ++a)
         end_cell[a] =
             std::clamp(static_cast<int>(std::floor((x1[a] - vol_.origin[a]) / vol_.voxel)),
