@@ -140,6 +140,10 @@ TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
     const double r = std::sqrt(std::max(0.0, 1 - z * z));
     p.d = Vec3(r * std::cos(phi), r * std::sin(phi), z);
     if (n % 50 == 1) p.d = Vec3(0, n % 100 == 1 ? 1.0 : -1.0, 0);        // along an axis
+    if (n % 50 == 2) {  // through voxel corners: faces on two axes at one distance (ties)
+      for (int a = 0; a < 3; ++a) p.x[a] = v.origin[a] + (p.cell[a] + 0.5) * v.voxel;
+      p.d = Vec3(std::sqrt(0.5), n % 100 == 2 ? std::sqrt(0.5) : -std::sqrt(0.5), 0);
+    }
     const double s_stop = -std::log(1 - rng.uniform()) * v.voxel * 0.9;  // within 3 voxels
     VoxelCrossings ref, got, safe;
     int axis = -1, end_ref[3], end[3], end_safe[3];
