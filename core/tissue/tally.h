@@ -10,7 +10,6 @@
 #include <limits>
 #include <vector>
 
-#include "core/branchless.h"
 #include "core/tissue/chunk_sums.h"
 #include "core/tissue/setup.h"
 #include "core/transport/photon.h"
@@ -149,7 +148,7 @@ class Tally {
     const bool next = i != pending_;
     queue_[queued_] = {pending_, fixed(pending_value_)};
     queued_ += next ? 1 : 0;
-    pending_value_ = select_if(next, x, pending_value_ + x);
+    pending_value_ = next ? x : pending_value_ + x;
     pending_ = i;
     if (queued_ == kQueue) drain();
   }

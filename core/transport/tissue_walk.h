@@ -215,24 +215,27 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
 inline void crossings_in_safe_box(const LabelVolume& vol, const Photon& p, double s_stop,
                                   int end_cell[3], VoxelCrossings& crossed) {
   const VoxelDda dda(p.x, p.d, p.cell, vol.origin, Vec3(vol.voxel));
-  double t[3] = {dda.t_max[0], dda.t_max[1], dda.t_max[2]};
-  int c[3] = {dda.cell[0], dda.cell[1], dda.cell[2]};
+  // In registers: an array indexed by the axis would chain each face through a store and a load.
+  double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
+  const double dx = dda.t_delta[0], dy = dda.t_delta[1], dz = dda.t_delta[2];
+  int cx = dda.cell[0], cy = dda.cell[1], cz = dda.cell[2];
   int count = 0;
   while (true) {
-    const double tx = t[0], ty = t[1], tz = t[2];
     // VoxelDda::axis(): x if tx < ty and tx < tz, else y if ty < tz (and not tx < ty), else z.
-    const int x_first = int{tx < ty} & int{tx < tz};
-    const int y_first = int{!(tx < ty)} & int{ty < tz};
-    const int a = 2 - 2 * x_first - y_first;
-    const double s = select_min(select_min(tx, ty), tz);  // t[a]: ties have one value
+    const bool x_first = (tx < ty) & (tx < tz);
+    const bool y_first = !(tx < ty) & (ty < tz);
+    const bool z_first = !x_first & !y_first;
+    const int a = 2 - 2 * int{x_first} - int{y_first};
+    const double s = select_min(select_min(tx, ty), tz);  // t of axis a: ties have one value
     if (s >= s_stop) break;
     if (count < VoxelCrossings::kMax) crossed.s[count] = s, crossed.axis[count] = int8_t(a);
     ++count;
-    t[a] += dda.t_delta[a];
-    c[a] += dda.step[a];
+    tx = select_if(x_first, tx + dx, tx), cx += int{x_first} * dda.step[0];
+    ty = select_if(y_first, ty + dy, ty), cy += int{y_first} * dda.step[1];
+    tz = select_if(z_first, tz + dz, tz), cz += int{z_first} * dda.step[2];
   }
   crossed.count = count;
-  end_cell[0] = c[0], end_cell[1] = c[1], end_cell[2] = c[2];
+  end_cell[0] = cx, end_cell[1] = cy, end_cell[2] = cz;
 }
 
 /// Puts p exactly on the face of its voxel on `axis` that it moves towards (no drift) and gives
