@@ -116,10 +116,11 @@ TEST_CASE("the walk's safe boxes give the distance to the next label of a plain 
 
 TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
   // The fluence tally takes a step's voxel faces from crossings_closed_form where each axis has
-  // at most one face, and from crossings_in_safe_box (which must equal the march exactly:
-  // catches a wrong tie rule or axis choice) for the other steps inside a safe box. Catches a face on the wrong side of the voxel, a wrong order of faces
-  // (a deposit into a voxel the step never enters), a step that crosses two faces on one axis
-  // taken as closed-form (a face missed), and an end voxel out of step with the march.
+  // at most one face, and from crossings_in_safe_box for the other steps inside a safe box.
+  // Catches a face on the wrong side of the voxel, a wrong order of faces (a deposit into a
+  // voxel the step never enters), a step that crosses two faces on one axis taken as
+  // closed-form (a face missed), an end voxel out of step with the march, and in the safe-box
+  // march a wrong axis choice or tie rule (it must equal the march bit for bit).
   LabelVolume v;
   v.n[0] = 12, v.n[1] = 10, v.n[2] = 14;
   v.voxel = 0.7;

@@ -196,8 +196,8 @@ inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const V
   auto exchange = [&](int i, int j) {
     const double ti = t[i], tj = t[j];
     const int flip = (ax[i] ^ ax[j]) & -int{tj < ti};
-    t[i] = select_min(ti, tj),
-    t[j] = select_max(tj, ti);  // (tj < ti ? tj : ti), (tj < ti ? ti : tj)
+    // (tj < ti ? tj : ti), (tj < ti ? ti : tj)
+    t[i] = select_min(ti, tj), t[j] = select_max(tj, ti);
     ax[i] ^= flip, ax[j] ^= flip;
   };
   exchange(0, 1), exchange(1, 2), exchange(0, 1);
@@ -228,7 +228,7 @@ inline void crossings_in_safe_box(const LabelVolume& vol, const Photon& p, doubl
     const int a = 2 - 2 * int{x_first} - int{y_first};
     const double s = select_min(select_min(tx, ty), tz);  // t of axis a: ties have one value
     if (s >= s_stop) break;
-    if (count < VoxelCrossings::kMax) crossed.s[count] = s, crossed.axis[count] = int8_t(a);
+    if (count < VoxelCrossings::kMax) crossed.s[count] = s, crossed.axis[count] = static_cast<int8_t>(a);
     ++count;
     tx = select_if(x_first, tx + dx, tx), cx += int{x_first} * dda.step[0];
     ty = select_if(y_first, ty + dy, ty), cy += int{y_first} * dda.step[1];
