@@ -228,7 +228,8 @@ inline void crossings_in_safe_box(const LabelVolume& vol, const Photon& p, doubl
     const int a = 2 - 2 * int{x_first} - int{y_first};
     const double s = select_min(select_min(tx, ty), tz);  // t of axis a: ties have one value
     if (s >= s_stop) break;
-    if (count < VoxelCrossings::kMax) crossed.s[count] = s, crossed.axis[count] = static_cast<int8_t>(a);
+    if (count < VoxelCrossings::kMax)
+      crossed.s[count] = s, crossed.axis[count] = static_cast<int8_t>(a);
     ++count;
     tx = select_if(x_first, tx + dx, tx), cx += int{x_first} * dda.step[0];
     ty = select_if(y_first, ty + dy, ty), cy += int{y_first} * dda.step[1];
