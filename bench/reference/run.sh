@@ -6,8 +6,8 @@
 # 2 threads, all on 1e6 photons, and prints photons/ms as each program reports it (MMC and
 # MCX-CL: their "speed" line, which leaves out setup, kernel compilation and output).
 #
+#   apt-get install pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers        # both use OpenCL
 #   git clone https://github.com/fangq/mmc && (cd mmc/src && make ssemath)      # CPU, SSE+OpenMP
-#   apt-get install pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers
 #   git clone https://github.com/fangq/mcxcl && (cd mcxcl/src && make)         # OpenCL on POCL
 #   bench/reference/run.sh build/femto-bench-tissue mmc/bin/mmc mcxcl/bin/mcxcl [ROUNDS]
 #
