@@ -60,7 +60,10 @@ double value_at(const char* p, int datatype, bool swap) {
   char tmp[8];
   const int n = bytes_of(datatype);
   std::memcpy(tmp, p, static_cast<size_t>(n));
-  if (swap) std::reverse(tmp, tmp + n);
+  // Fixed lengths: with a variable one, GCC 12's AVX2 code raised a false -Wstringop-overflow.
+  if (swap && n == 2) std::reverse(tmp, tmp + 2);
+  if (swap && n == 4) std::reverse(tmp, tmp + 4);
+  if (swap && n == 8) std::reverse(tmp, tmp + 8);
   auto as = [&](auto v) {
     std::memcpy(&v, tmp, sizeof v);
     return static_cast<double>(v);
