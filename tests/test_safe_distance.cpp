@@ -165,6 +165,22 @@ TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
     int per_axis[3] = {0, 0, 0};
     for (int q = 0; q < ref.count; ++q) ++per_axis[ref.axis[q]];
     const bool single = per_axis[0] <= 1 && per_axis[1] <= 1 && per_axis[2] <= 1;
+#if defined(__AVX2__) && defined(__FMA__)
+    {  // the AVX form of the per-axis stage (what this build's walk uses) against the scalar one
+      double t_s[4], t_v[4];
+      int end_s[3], end_v[3], count_s = -1, count_v = -1;
+      const bool single_s = axis_faces_scalar(v, p.x, p.d, p.cell, s_stop, t_s, end_s, count_s);
+      const bool single_v = axis_faces_avx2(v, p.x, p.d, p.cell, s_stop, t_v, end_v, count_v);
+      REQUIRE(single_v == single_s);
+      if (single_s) {
+        CHECK(count_v == count_s);
+        for (int a = 0; a < 3; ++a) {
+          CHECK(end_v[a] == end_s[a]);
+          CHECK(t_v[a] == Approx(t_s[a]).epsilon(1e-12).margin(1e-12));
+        }
+      }
+    }
+#endif
     if (!crossings_closed_form(v, p.x, p.d, p.cell, s_stop, end, got)) {
       ++declined;
       CHECK_FALSE(single);

@@ -14,6 +14,7 @@
 #include "core/bsdf/fresnel.h"
 #include "core/constants.h"
 #include "core/rng.h"
+#include "core/transport/closed_form_faces.h"
 #include "core/transport/photon.h"
 #include "core/transport/safe_distance.h"
 #include "core/transport/tissue_volume.h"
@@ -157,54 +158,6 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
   }
   end_cell[0] = cx, end_cell[1] = cy, end_cell[2] = cz;
   return s;
-}
-
-/// The voxel faces crossed by the piece p.x + p.d s, s in [0, s_stop), in closed form when it
-/// crosses at most one face per axis (most steps: a mean free path is about a voxel), without the
-/// march's unpredictable choice of the next axis: the up to three face distances are sorted by a
-/// fixed network. Every voxel on the way must have p's label (a safe box). Returns false, with
-/// nothing written, when an axis has two or more faces before s_stop (the march's case).
-inline bool crossings_closed_form(const LabelVolume& vol, const Vec3& x, const Vec3& dir,
-                                  const int cell[3], double s_stop, int end_cell[3],
-                                  VoxelCrossings& crossed) {
-  static constexpr double kBeyond[2] = {kInf, 0.0};  // added to a face distance: no face, a face
-  double t[3];
-  bool cross[3];
-  bool single = true;
-  // Plain arrays: Vec3's operator[] is a chain of selects where a loop is not unrolled.
-  const double o[3] = {vol.origin.x, vol.origin.y, vol.origin.z}, xs[3] = {x.x, x.y, x.z},
-               ds[3] = {dir.x, dir.y, dir.z};
-  const double h = vol.voxel;
-  for (int a = 0; a < 3; ++a) {
-    const double d = ds[a];
-    const bool up = d > 0;
-    const double face = o[a] + (cell[a] + (up ? 1 : 0)) * h;  // as the march computes it
-    const double inv_d = 1 / d;  // one division per axis
-    const double ta = d != 0 ? select_max(0.0, (face - xs[a]) * inv_d) : kInf;
-    const double delta = d != 0 ? h * std::abs(inv_d) : kInf;
-    // Whether an axis has a face is a coin flip for a branch predictor: no branch on it below.
-    const bool c = ta < s_stop;
-    cross[a] = c;
-    single &= !(ta + delta < s_stop);
-    t[a] = ta + kBeyond[c];  // +inf sorts an axis without a face last
-    end_cell[a] = cell[a] + int{c} * (2 * int{up} - 1);
-  }
-  if (!single) return false;
-  // Sort (t, axis) by t: three compare-exchanges (minsd, maxsd and an integer blend: no branch,
-  // where std::min and std::max became jumps); ties keep the lower axis first.
-  int ax[3] = {0, 1, 2};
-  auto exchange = [&](int i, int j) {
-    const double ti = t[i], tj = t[j];
-    const int flip = (ax[i] ^ ax[j]) & -int{tj < ti};
-    // (tj < ti ? tj : ti), (tj < ti ? ti : tj)
-    t[i] = select_min(ti, tj), t[j] = select_max(tj, ti);
-    ax[i] ^= flip, ax[j] ^= flip;
-  };
-  exchange(0, 1), exchange(1, 2), exchange(0, 1);
-  const int count = int{cross[0]} + int{cross[1]} + int{cross[2]};
-  for (int q = 0; q < 3; ++q) crossed.s[q] = t[q], crossed.axis[q] = static_cast<int8_t>(ax[q]);
-  crossed.count = count;
-  return true;
 }
 
 /// The voxel faces crossed by the piece p.x + p.d s, s in [0, s_stop), when every voxel on the
