@@ -36,7 +36,7 @@ inline bool axis_faces_scalar(const LabelVolume& vol, const Vec3& x, const Vec3&
     const double d = ds[a];
     const bool up = d > 0;
     const double face = o[a] + (cell[a] + (up ? 1 : 0)) * h;  // as the march computes it
-    const double inv_d = 1 / d;  // one division per axis
+    const double inv_d = 1 / d;                               // one division per axis
     const double ta = d != 0 ? select_max(0.0, (face - xs[a]) * inv_d) : kInf;
     const double delta = d != 0 ? h * std::abs(inv_d) : kInf;
     const bool c = ta < s_stop;
