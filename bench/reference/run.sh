@@ -11,7 +11,7 @@
 #   git clone https://github.com/fangq/mcxcl && (cd mcxcl/src && make)         # OpenCL on POCL
 #   bench/reference/run.sh build/femto-bench-tissue mmc/bin/mmc mcxcl/bin/mcxcl [ROUNDS]
 #
-# Run from the source root. Pass "-" for a code you do not have.
+# Run from the source root. Pass "-" for a program to leave out.
 set -eu
 femto=$1 mmc=$2 mcxcl=$3 rounds=${4:-3}
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -23,8 +23,10 @@ echo "CPU: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; load $(cut -
 strip() { sed 's/\x1b\[[0-9;]*m//g'; }
 for r in $(seq "$rounds"); do
   # femto: the bench's 1- and 2-thread rows (photons/ms wall clock, the absorbed fraction).
-  "$femto" "$root/data/scenes/cube60.json" 1e6 > "$work/femto" 2>&1
-  awk -v r="$r" 'NF == 9 && $1 ~ /^[12]$/ {printf "round %s femto  threads %s  %7.1f photons/ms  absorbed %s\n", r, $1, $2, $9}' "$work/femto"
+  if [ "$femto" != - ]; then
+    "$femto" "$root/data/scenes/cube60.json" 1e6 > "$work/femto" 2>&1
+    awk -v r="$r" 'NF == 9 && $1 ~ /^[12]$/ {printf "round %s femto  threads %s  %7.1f photons/ms  absorbed %s\n", r, $1, $2, $9}' "$work/femto"
+  fi
   for t in 1 2; do
     if [ "$mmc" != - ]; then
       (cd "$work" && OMP_NUM_THREADS=$t "$mmc" -f mmc_cube60.json -c sse -M G -n 1e6 -b 0 -O F -F bin \
