@@ -148,6 +148,7 @@ int cmd_diffusion(const std::vector<std::string>& argv_in, const std::string& co
   opt.plot_times = request.plot_times;
   opt.run = {{"femto_version", FEMTO_VERSION},
              {"femto_build", FEMTO_GIT_DESCRIBE},
+             {"femto_instruction_set", FEMTO_INSTRUCTION_SET},
              {"command", command_line},
              {"date_utc", cli::utc_now()},
              {"source", request.source},

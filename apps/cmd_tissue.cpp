@@ -151,6 +151,7 @@ int run_tissue_scene(const std::string& text, const std::string& path, const Tis
   nlohmann::json record = {
       {"femto_version", FEMTO_VERSION},
       {"femto_build", FEMTO_GIT_DESCRIBE},
+      {"femto_instruction_set", FEMTO_INSTRUCTION_SET},
       {"command", command_line},
       {"date_utc", cli::utc_now()},
       {"mode", "tissue"},

@@ -56,8 +56,8 @@ int main(int argc, char** argv) {
     return leave(args.empty() ? 2 : 0);
   }
   if (args[0] == "--version" || args[0] == "-V") {
-    std::printf("femto %s (%s%s)\n", FEMTO_VERSION, FEMTO_GIT_DESCRIBE,
-                femto::distributed::mpi_built() ? ", MPI" : "");
+    std::printf("femto %s (%s%s, instruction set %s)\n", FEMTO_VERSION, FEMTO_GIT_DESCRIBE,
+                femto::distributed::mpi_built() ? ", MPI" : "", FEMTO_INSTRUCTION_SET);
     return leave(0);
   }
   const std::string name = args[0];

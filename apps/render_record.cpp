@@ -183,6 +183,7 @@ nlohmann::json render_fingerprint(const std::string& scene_text, const SceneDesc
                      {"direction_sampling", static_cast<int>(m.direction)}});
   return {{"femto_version", FEMTO_VERSION},
           {"femto_build", FEMTO_GIT_DESCRIBE},
+          {"femto_instruction_set", FEMTO_INSTRUCTION_SET},
           {"scene_sha256", sha256_hex(scene_text)},
           {"settings",
            {{"spp", opt.spp},
@@ -230,6 +231,7 @@ nlohmann::json render_info(const Scene& scene, const std::string& scene_text, co
   nlohmann::json info;
   info["femto_version"] = FEMTO_VERSION;
   info["femto_build"] = FEMTO_GIT_DESCRIBE;
+  info["femto_instruction_set"] = FEMTO_INSTRUCTION_SET;
   info["scene"] = {{"source", scene.desc().source},
                    {"json", scene_json(scene_text)}};
   if (!scene.desc().warnings.empty()) info["scene"]["warnings"] = scene.desc().warnings;

@@ -279,6 +279,8 @@ TEST_CASE("cli: --version and --help", "[cli]") {
     CHECK(std::regex_search(r.out, std::regex(R"(^femto [0-9]+\.[0-9]+\.[0-9]+)")));
     CHECK(count_lines(r.out) == 1);
     CHECK(r.err.empty());
+    // The instruction set decides the last bits of every output: a bug report needs it.
+    CHECK(cli_contains(r.out, std::string("instruction set ") + FEMTO_INSTRUCTION_SET + ")"));
   }
   SECTION("--help") {
     // Catches: top-level help exiting non-zero or not mentioning the render command.

@@ -21,7 +21,8 @@ def test_bits_equal_the_command(scene_file, tmp_path):
     assert np.array_equal(result.transient, expected)
     # The record matches render.json where both describe the same render.
     for key in ("settings", "time_axis", "film", "counters", "energy", "media", "scene",
-                "complete", "femto_version", "femto_build"):
+                "complete", "femto_version", "femto_build",
+                "femto_instruction_set"):
         assert result.meta[key] == record[key], key
     assert result.meta["progress"]["units_done"] == record["progress"]["units_done"]
 
