@@ -94,6 +94,29 @@ TEST_CASE("tissue outputs are bit-identical for any thread count", "[tissue]") {
   REQUIRE(a.detected.size() > 10);
 }
 
+// Runs of several waves (65,536 photons each, walked gate by gate with each gate's chunks shared
+// among the threads): catches a chunk's deposits going to another thread's sums while it walks,
+// deposits left in a queue between gates, and chunks finished twice or never (the balance).
+TEST_CASE("tissue runs of several waves are bit-identical for any thread count", "[tissue]") {
+  Setup s = tissue_box(8, 8, 8, 1.0, TissueOptics{0.05, 0.5, 0.5, 1.4});  // a few steps each
+  s.fresnel = true;
+  s.time = TimeAxis{0, 10, 8};
+  s.detectors = {{{4, 4, 0}, 3.0, 0.0}};
+  s.faces = true;
+  s.batches = 1;
+  s.photons = 2 * 65536 + 3000;  // two whole waves and part of a third
+  s.threads = 1;
+  const Result a = simulate(s);
+  s.threads = 2;
+  const Result b = simulate(s);
+  femto::test::check_same_outputs(a, b);
+  CHECK(a.detected.ppath == b.detected.ppath);
+  CHECK(a.balance.launched == static_cast<double>(s.photons));
+  CHECK(std::abs(a.balance.residual()) <= 1e-12 * a.balance.launched);
+  CHECK(a.balance.alive > 0);  // some photons walk through every gate
+  REQUIRE(a.detected.size() > 1000);
+}
+
 // Catches detected-photon records out of photon order (a chunk's photons walk gate by gate, so
 // they are detected gate by gate): the records of the first photons of a run are the first
 // records of a longer run with the same seed, in the same order.

@@ -33,6 +33,10 @@ double Balance::residual() const {
 
 namespace {
 constexpr uint64_t kChunk = 1024;  // photons per task: the unit of ordered reduction
+// Chunks walked together, gate by gate: every photon of a wave reaches the end of gate j before
+// any goes on into gate j + 1, so one gate's grid of sums takes the wave's deposits while it is in
+// cache (a single chunk's photons touched most of it once per chunk: mostly cache misses).
+constexpr size_t kWaveChunks = 64;
 
 // The fixed-point scale 2^k: no cell of any sum can overflow 2^63 (a photon's track length is at
 // most c times the window; a launched photon's weight is at most max_weight).
@@ -83,13 +87,11 @@ bool walk_until(const Space& space, const WalkSettings& stop, bool last, Photon&
   return false;
 }
 
-// Photons q0 .. q1 - 1, launched, then walked gate by gate: every photon of the chunk to the end
-// of gate j before any goes on into gate j + 1, so the fluence deposits fall into one gate's grid
-// at a time (it stays in cache). Photon i always draws from Rng::for_sample(seed, i, 0).
-template <class Space, class Tally>
-void trace_chunk(const Setup& s, const Space& space, const Emitter& emitter, const WalkSettings& ws,
-                 uint64_t q0, uint64_t q1, Tally& tally, ChunkSums& out) {
-  std::vector<Walker> walkers;
+// Photons q0 .. q1 - 1 of a chunk, launched into `walkers`. Photon i always draws from
+// Rng::for_sample(seed, i, 0).
+template <class Space>
+void launch_chunk(const Setup& s, const Space& space, const Emitter& emitter, uint64_t q0,
+                  uint64_t q1, std::vector<Walker>& walkers, ChunkSums& out) {
   walkers.reserve(static_cast<size_t>(q1 - q0));
   for (uint64_t i = q0; i < q1; ++i) {
     Walker w{Photon{}, Rng::for_sample(s.seed, i, 0), static_cast<uint32_t>(i - q0)};
@@ -103,24 +105,25 @@ void trace_chunk(const Setup& s, const Space& space, const Emitter& emitter, con
     out.balance.specular += specular;
     walkers.push_back(w);
   }
-  tally.start_chunk(out, static_cast<size_t>(q1 - q0));
-  // Without a fluence volume, nothing gains from the gates' stops: one turn to the window end.
-  const int turns = s.fluence ? s.time.bins : 1;
-  for (int j = 0; j < turns && !walkers.empty(); ++j) {
-    const bool last = j + 1 == turns;
-    WalkSettings stop = ws;
-    if (!last) stop.t_end = s.time.bin_start_ps(j + 1);
-    size_t kept = 0;
-    if (s.fluence) tally.gate(j);
-    for (Walker& w : walkers) {
-      tally.begin(w.slot);
-      const bool on = walk_until(space, stop, last, w.p, w.rng, tally, out);
-      tally.end();
-      if (on) walkers[kept++] = w;
-    }
-    walkers.resize(kept);
+}
+
+// Turn j of a chunk: its photons, in order, to the end of gate j (the last turn: to the window
+// end); those that walk on stay in `walkers`.
+template <class Space, class Tally>
+void walk_turn(const Setup& s, const Space& space, const WalkSettings& ws, int j, int turns,
+               std::vector<Walker>& walkers, Tally& tally, ChunkSums& out) {
+  const bool last = j + 1 == turns;
+  WalkSettings stop = ws;
+  if (!last) stop.t_end = s.time.bin_start_ps(j + 1);
+  size_t kept = 0;
+  if (s.fluence) tally.gate(j);
+  for (Walker& w : walkers) {
+    tally.begin(w.slot);
+    const bool on = walk_until(space, stop, last, w.p, w.rng, tally, out);
+    tally.end();
+    if (on) walkers[kept++] = w;
   }
-  tally.end_chunk();
+  walkers.resize(kept);
 }
 }  // namespace
 
@@ -148,6 +151,9 @@ uint64_t memory_bytes(const Setup& s, int threads) {
   const uint64_t record = 8 * 2 + 4 * 2 + 8 * (s.volume.optics.size());
   if (!s.detectors.empty() && s.save_detected)
     bytes += record * std::min<uint64_t>(s.max_detected, s.photons);
+  // The photons of one wave between gates, and their partial paths with detectors.
+  const uint64_t wave = std::min<uint64_t>(s.photons, kWaveChunks * kChunk);
+  bytes += wave * (sizeof(Walker) + (s.detectors.empty() ? 0 : 8 * s.volume.optics.size()));
   // The walk's safe distances: one byte per voxel (core/transport/safe_distance.h).
   return bytes + s.volume.memory_bytes() + s.volume.cells();
 }
@@ -216,23 +222,55 @@ Result simulate(const Setup& s) {
     const size_t chunks = static_cast<size_t>((p1 - p0 + kChunk - 1) / kChunk);
     std::vector<ChunkSums> chunk(chunks);
     const auto trace_start = std::chrono::steady_clock::now();
-    arena.execute([&] {
-      tbb::parallel_for(size_t{0}, chunks, [&](size_t c) {
-        if (!comm.owns(static_cast<int64_t>(c))) return;
-        if (s.stop && s.stop->load()) return;  // the batch is thrown away: Stopped below
-        ThreadSums& ts = thread_sums.local();
-        ChunkSums& out = chunk[c];
-        out.reset(labels, tpsf_size, ndet);
-        Tally tally(s, ts, scale);
-        const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
-        if (voxel_space)
-          trace_chunk(s, *voxel_space, emitter, ws, q0, q1, tally, out);
-        else
-          trace_chunk(s, space, emitter, ws, q0, q1, tally, out);
-        progress.add(q1 - q0);
-        if (s.photons_done) s.photons_done->fetch_add(q1 - q0);
-      });
-    });
+    // Wave by wave; within a wave, gate by gate (kWaveChunks); within a gate, chunk by chunk on
+    // any thread. A chunk's own sums see its photons in the same order whichever thread walks
+    // it, and its volume deposits are integers: the outputs do not depend on the threads.
+    // Without a fluence volume, nothing gains from the gates' stops: one turn to the window end.
+    const int turns = s.fluence ? gates : 1;
+    for (size_t w0 = 0; w0 < chunks; w0 += kWaveChunks) {
+      const size_t w1 = std::min(chunks, w0 + kWaveChunks);
+      std::vector<std::vector<Walker>> walkers(w1 - w0);
+      std::vector<std::optional<Tally>> tally(w1 - w0);
+      std::vector<char> done(w1 - w0, 0);
+      for (int j = 0; j < turns; ++j) {
+        arena.execute([&] {
+          tbb::parallel_for(w0, w1, [&](size_t c) {
+            const size_t k = c - w0;
+            if (done[k]) return;
+            // Another rank's chunk, or a stopped run (the batch is thrown away: Stopped below).
+            if (!comm.owns(static_cast<int64_t>(c)) || (s.stop && s.stop->load())) {
+              done[k] = 1;
+              return;
+            }
+            ChunkSums& out = chunk[c];
+            const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
+            if (j == 0) {
+              out.reset(labels, tpsf_size, ndet);
+              if (voxel_space)
+                launch_chunk(s, *voxel_space, emitter, q0, q1, walkers[k], out);
+              else
+                launch_chunk(s, space, emitter, q0, q1, walkers[k], out);
+              tally[k].emplace(s, scale);
+              tally[k]->start_chunk(out, static_cast<size_t>(q1 - q0));
+            }
+            tally[k]->bind(thread_sums.local());
+            if (voxel_space)
+              walk_turn(s, *voxel_space, ws, j, turns, walkers[k], *tally[k], out);
+            else
+              walk_turn(s, space, ws, j, turns, walkers[k], *tally[k], out);
+            tally[k]->unbind();
+            if (!walkers[k].empty() && j + 1 < turns) return;
+            tally[k]->end_chunk();
+            tally[k].reset();
+            std::vector<Walker>().swap(walkers[k]);
+            done[k] = 1;
+            progress.add(q1 - q0);
+            if (s.photons_done) s.photons_done->fetch_add(q1 - q0);
+          });
+        });
+        if (std::all_of(done.begin(), done.end(), [](char d) { return d != 0; })) break;
+      }
+    }
     r.trace_seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - trace_start).count();
     if (s.stop && s.stop->load()) throw Stopped();

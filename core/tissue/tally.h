@@ -37,19 +37,27 @@ struct BrickLayout {
   size_t index(int i, int j, int k) const { return part(0, i) + part(1, j) + part(2, k); }
 };
 
-/// Integer sums of the volume tallies of one thread (fixed point: order-independent).
+/// A fluence deposit waiting in a thread's queue.
+struct Deposit {
+  size_t index;    ///< gate * slots + brick slot
+  uint64_t value;  ///< fixed point
+};
+
+/// Integer sums of the volume tallies of one thread (fixed point: order-independent), and the
+/// queue of its deposits not yet added.
 struct ThreadSums {
   std::vector<uint64_t> fluence;
   std::array<std::vector<uint64_t>, 6> faces;
+  std::vector<Deposit> queue;
 };
 
-/// The tallies of one photon walk, plugged into walk_step's loop.
+/// The tallies of the photon walks of one chunk, plugged into walk_step's loop. The chunk's sums
+/// stay with it; its volume deposits go to the sums of the thread that walks it (bind, unbind).
 class Tally {
  public:
-  Tally(const Setup& s, ThreadSums& sums, double scale)
+  Tally(const Setup& s, double scale)
       : layout_(s.fluence_grid.n),
         s_(s),
-        sums_(sums),
         scale_(scale),
         gates_(s.time.bins),
         same_grid_(s.fluence && same_grid(s)),
@@ -58,7 +66,6 @@ class Tally {
     h_ = fg.spacing();
     cells_ = layout_.slots;
     plane_tolerance_ = 1e-6 * s.volume.voxel;
-    queue_.resize(kQueue);
     for (int a = 0; a < 3; ++a)
       for (int c = 0; c < fg.n[a]; ++c) part_[static_cast<size_t>(a)].push_back(layout_.part(a, c));
   }
@@ -67,6 +74,19 @@ class Tally {
     out_ = &out;
     ppaths_.assign(s_.detectors.empty() ? 0 : photons * labels_, 0.0);
     record_photon_.clear();
+  }
+  /// The thread walking the chunk now: its sums take the deposits until unbind().
+  void bind(ThreadSums& sums) {
+    if (sums.queue.size() < kQueue) sums.queue.resize(kQueue);
+    sums_ = &sums;
+    queue_ = sums.queue.data();
+    queued_ = 0;
+  }
+  /// The deposits still queued go into the bound thread's sums.
+  void unbind() {
+    drain();
+    sums_ = nullptr;
+    queue_ = nullptr;
   }
   /// The walk is in gate j (it stops at the gate's end): segments inside it deposit there.
   void gate(int j) {
@@ -114,12 +134,8 @@ class Tally {
   void end() {
     if (s_.fluence) flush();
   }
-  /// The chunk's detected-photon records in photon order (they were made gate by gate); the
-  /// deposits still queued go into the sums.
-  void end_chunk() {
-    drain();
-    sort_records(out_->records, record_photon_);
-  }
+  /// The chunk's detected-photon records in photon order (they were made gate by gate).
+  void end_chunk() { sort_records(out_->records, record_photon_); }
   /// Where the walk should record the voxel faces of its steps (nullptr: not needed).
   VoxelCrossings* crossings() { return same_grid_ ? &crossings_ : nullptr; }
 
@@ -163,8 +179,8 @@ class Tally {
   // would wait for each one).
   void drain() {
     constexpr size_t kAhead = 32;
-    uint64_t* sums = sums_.fluence.data();
-    const Deposit* q = queue_.data();
+    uint64_t* sums = sums_->fluence.data();
+    const Deposit* q = queue_;
     const size_t n = queued_;
     for (size_t i = 0; i < std::min(n, kAhead); ++i) __builtin_prefetch(sums + q[i].index, 1);
     for (size_t i = 0; i < n; ++i) {
@@ -312,7 +328,7 @@ class Tally {
     const int axis = face / 2, b = axis == 0 ? 1 : 0, c = axis == 2 ? 1 : 2;
     const LabelVolume& vol = s_.volume;
     const size_t pix = static_cast<size_t>(p.cell[b]) * vol.n[c] + p.cell[c];
-    sums_.faces[static_cast<size_t>(face)][pix * gates_ + gate] += fixed(p.w);
+    sums_->faces[static_cast<size_t>(face)][pix * gates_ + gate] += fixed(p.w);
   }
 
   void detect(const Photon& p) {
@@ -346,19 +362,15 @@ class Tally {
 
   BrickLayout layout_;
   const Setup& s_;
-  ThreadSums& sums_;
+  ThreadSums* sums_ = nullptr;  // the bound thread's
   double scale_;
   int gates_;
   bool same_grid_;
   Vec3 h_;
   size_t cells_ = 0;
   double plane_tolerance_ = 0;
-  struct Deposit {
-    size_t index;    // gate * cells_ + brick slot
-    uint64_t value;  // fixed point
-  };
   static constexpr size_t kQueue = 4096;  // 64 KiB: stays in L2 between its fill and drain
-  std::vector<Deposit> queue_;            // kQueue slots; queued_ of them filled
+  Deposit* queue_ = nullptr;              // the bound thread's: kQueue slots, queued_ filled
   size_t queued_ = 0;
   double gate_lo_ = kInf, gate_hi_ = -kInf;  // the current gate (none yet)
   size_t gate_offset_ = 0;
