@@ -37,6 +37,8 @@ constexpr uint64_t kChunk = 1024;  // photons per task: the unit of ordered redu
 // any goes on into gate j + 1, so one gate's grid of sums takes the wave's deposits while it is in
 // cache (a single chunk's photons touched most of it once per chunk: mostly cache misses).
 constexpr size_t kWaveChunks = 64;
+// Chunks per wave: at least kWaveChunks, and enough to keep every thread busy in every gate.
+size_t wave_chunks(int threads) { return std::max(kWaveChunks, 4 * static_cast<size_t>(threads)); }
 
 // The fixed-point scale 2^k: no cell of any sum can overflow 2^63 (a photon's track length is at
 // most c times the window; a launched photon's weight is at most max_weight).
@@ -151,9 +153,13 @@ uint64_t memory_bytes(const Setup& s, int threads) {
   const uint64_t record = 8 * 2 + 4 * 2 + 8 * (s.volume.optics.size());
   if (!s.detectors.empty() && s.save_detected)
     bytes += record * std::min<uint64_t>(s.max_detected, s.photons);
-  // The photons of one wave between gates, and their partial paths with detectors.
-  const uint64_t wave = std::min<uint64_t>(s.photons, kWaveChunks * kChunk);
+  // The photons of one wave between gates, their partial paths with detectors, and the
+  // chunks' tallies (slot tables per axis).
+  const uint64_t wave = std::min<uint64_t>(s.photons, wave_chunks(threads) * kChunk);
   bytes += wave * (sizeof(Walker) + (s.detectors.empty() ? 0 : 8 * s.volume.optics.size()));
+  const FluenceGrid& fg = s.fluence_grid;
+  bytes += wave_chunks(threads) *
+           (sizeof(Tally) + 8 * static_cast<uint64_t>(fg.n[0] + fg.n[1] + fg.n[2]));
   // The walk's safe distances: one byte per voxel (core/transport/safe_distance.h).
   return bytes + s.volume.memory_bytes() + s.volume.cells();
 }
@@ -216,29 +222,33 @@ Result simulate(const Setup& s) {
   }
   Progress progress(own_photons, "tissue", s.quiet, "photons");
   tbb::task_arena arena(threads);
+  const size_t wave = wave_chunks(threads);
   for (int b = 0; b < batches; ++b) {
     uint64_t p0, p1;
     batch_range(b, p0, p1);
     const size_t chunks = static_cast<size_t>((p1 - p0 + kChunk - 1) / kChunk);
     std::vector<ChunkSums> chunk(chunks);
     const auto trace_start = std::chrono::steady_clock::now();
-    // Wave by wave; within a wave, gate by gate (kWaveChunks); within a gate, chunk by chunk on
-    // any thread. A chunk's own sums see its photons in the same order whichever thread walks
-    // it, and its volume deposits are integers: the outputs do not depend on the threads.
-    // Without a fluence volume, nothing gains from the gates' stops: one turn to the window end.
+    // Wave by wave (this rank's chunks only); within a wave, gate by gate; within a gate, chunk
+    // by chunk on any thread. A chunk's own sums see its photons in the same order whichever
+    // thread walks it, and its volume deposits are integers: the outputs do not depend on the
+    // threads or ranks. Without a fluence volume, nothing gains from the gates' stops: one turn
+    // to the window end.
     const int turns = s.fluence ? gates : 1;
-    for (size_t w0 = 0; w0 < chunks; w0 += kWaveChunks) {
-      const size_t w1 = std::min(chunks, w0 + kWaveChunks);
+    std::vector<size_t> owned;
+    for (size_t c = 0; c < chunks; ++c)
+      if (comm.owns(static_cast<int64_t>(c))) owned.push_back(c);
+    for (size_t w0 = 0; w0 < owned.size(); w0 += wave) {
+      const size_t w1 = std::min(owned.size(), w0 + wave);
       std::vector<std::vector<Walker>> walkers(w1 - w0);
       std::vector<std::optional<Tally>> tally(w1 - w0);
       std::vector<char> done(w1 - w0, 0);
       for (int j = 0; j < turns; ++j) {
         arena.execute([&] {
-          tbb::parallel_for(w0, w1, [&](size_t c) {
-            const size_t k = c - w0;
+          tbb::parallel_for(w0, w1, [&](size_t i) {
+            const size_t k = i - w0, c = owned[i];
             if (done[k]) return;
-            // Another rank's chunk, or a stopped run (the batch is thrown away: Stopped below).
-            if (!comm.owns(static_cast<int64_t>(c)) || (s.stop && s.stop->load())) {
+            if (s.stop && s.stop->load()) {  // the batch is thrown away: Stopped below
               done[k] = 1;
               return;
             }
@@ -253,6 +263,8 @@ Result simulate(const Setup& s) {
               tally[k].emplace(s, scale);
               tally[k]->start_chunk(out, static_cast<size_t>(q1 - q0));
             }
+            // The thread's deposit queue is this task's until unbind: nothing in between may
+            // wait on TBB (another task run meanwhile on this thread would share the queue).
             tally[k]->bind(thread_sums.local());
             if (voxel_space)
               walk_turn(s, *voxel_space, ws, j, turns, walkers[k], *tally[k], out);
@@ -270,6 +282,7 @@ Result simulate(const Setup& s) {
         });
         if (std::all_of(done.begin(), done.end(), [](char d) { return d != 0; })) break;
       }
+      if (s.stop && s.stop->load()) break;
     }
     r.trace_seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - trace_start).count();

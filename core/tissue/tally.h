@@ -75,12 +75,12 @@ class Tally {
     ppaths_.assign(s_.detectors.empty() ? 0 : photons * labels_, 0.0);
     record_photon_.clear();
   }
-  /// The thread walking the chunk now: its sums take the deposits until unbind().
+  /// The thread walking the chunk now: its sums take the deposits until unbind(). Its queue is
+  /// shared by every Tally the thread binds (one at a time; unbind leaves it empty).
   void bind(ThreadSums& sums) {
     if (sums.queue.size() < kQueue) sums.queue.resize(kQueue);
     sums_ = &sums;
     queue_ = sums.queue.data();
-    queued_ = 0;
   }
   /// The deposits still queued go into the bound thread's sums.
   void unbind() {
