@@ -38,7 +38,9 @@ constexpr uint64_t kChunk = 1024;  // photons per task: the unit of ordered redu
 // cache (a single chunk's photons touched most of it once per chunk: mostly cache misses).
 constexpr size_t kWaveChunks = 64;
 // Chunks per wave: at least kWaveChunks, and enough to keep every thread busy in every gate.
-size_t wave_chunks(int threads) { return std::max(kWaveChunks, 4 * static_cast<size_t>(threads)); }
+size_t wave_chunks(int threads) {
+  return std::max(kWaveChunks, 4 * static_cast<size_t>(threads));
+}
 
 // The fixed-point scale 2^k: no cell of any sum can overflow 2^63 (a photon's track length is at
 // most c times the window; a launched photon's weight is at most max_weight).
