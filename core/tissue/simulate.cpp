@@ -240,49 +240,62 @@ Result simulate(const Setup& s) {
     std::vector<size_t> owned;
     for (size_t c = 0; c < chunks; ++c)
       if (comm.owns(static_cast<int64_t>(c))) owned.push_back(c);
+    // With few chunks per thread a stop at every gate would leave threads waiting for the
+    // slowest chunk; then each task walks its chunk through all gates.
+    const bool gate_stops = threads == 1 || owned.size() >= 8 * static_cast<size_t>(threads);
     for (size_t w0 = 0; w0 < owned.size(); w0 += wave) {
       const size_t w1 = std::min(owned.size(), w0 + wave);
       std::vector<std::vector<Walker>> walkers(w1 - w0);
       std::vector<std::optional<Tally>> tally(w1 - w0);
       std::vector<char> done(w1 - w0, 0);
-      for (int j = 0; j < turns; ++j) {
+      // Turn j of chunk owned[i]; false once the chunk is done.
+      auto turn = [&](size_t i, int j) {
+        const size_t k = i - w0, c = owned[i];
+        if (done[k]) return false;
+        if (s.stop && s.stop->load()) {  // the batch is thrown away: Stopped below
+          done[k] = 1;
+          return false;
+        }
+        ChunkSums& out = chunk[c];
+        const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
+        if (j == 0) {
+          out.reset(labels, tpsf_size, ndet);
+          if (voxel_space)
+            launch_chunk(s, *voxel_space, emitter, q0, q1, walkers[k], out);
+          else
+            launch_chunk(s, space, emitter, q0, q1, walkers[k], out);
+          tally[k].emplace(s, scale);
+          tally[k]->start_chunk(out, static_cast<size_t>(q1 - q0));
+        }
+        // The thread's deposit queue is this task's until unbind: nothing in between may wait
+        // on TBB (another task run meanwhile on this thread would share the queue).
+        tally[k]->bind(thread_sums.local());
+        if (voxel_space)
+          walk_turn(s, *voxel_space, ws, j, turns, walkers[k], *tally[k], out);
+        else
+          walk_turn(s, space, ws, j, turns, walkers[k], *tally[k], out);
+        tally[k]->unbind();
+        if (!walkers[k].empty() && j + 1 < turns) return true;
+        tally[k]->end_chunk();
+        tally[k].reset();
+        std::vector<Walker>().swap(walkers[k]);
+        done[k] = 1;
+        progress.add(q1 - q0);
+        if (s.photons_done) s.photons_done->fetch_add(q1 - q0);
+        return false;
+      };
+      if (!gate_stops) {
         arena.execute([&] {
           tbb::parallel_for(w0, w1, [&](size_t i) {
-            const size_t k = i - w0, c = owned[i];
-            if (done[k]) return;
-            if (s.stop && s.stop->load()) {  // the batch is thrown away: Stopped below
-              done[k] = 1;
-              return;
+            for (int j = 0; j < turns && turn(i, j); ++j) {
             }
-            ChunkSums& out = chunk[c];
-            const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
-            if (j == 0) {
-              out.reset(labels, tpsf_size, ndet);
-              if (voxel_space)
-                launch_chunk(s, *voxel_space, emitter, q0, q1, walkers[k], out);
-              else
-                launch_chunk(s, space, emitter, q0, q1, walkers[k], out);
-              tally[k].emplace(s, scale);
-              tally[k]->start_chunk(out, static_cast<size_t>(q1 - q0));
-            }
-            // The thread's deposit queue is this task's until unbind: nothing in between may
-            // wait on TBB (another task run meanwhile on this thread would share the queue).
-            tally[k]->bind(thread_sums.local());
-            if (voxel_space)
-              walk_turn(s, *voxel_space, ws, j, turns, walkers[k], *tally[k], out);
-            else
-              walk_turn(s, space, ws, j, turns, walkers[k], *tally[k], out);
-            tally[k]->unbind();
-            if (!walkers[k].empty() && j + 1 < turns) return;
-            tally[k]->end_chunk();
-            tally[k].reset();
-            std::vector<Walker>().swap(walkers[k]);
-            done[k] = 1;
-            progress.add(q1 - q0);
-            if (s.photons_done) s.photons_done->fetch_add(q1 - q0);
           });
         });
-        if (std::all_of(done.begin(), done.end(), [](char d) { return d != 0; })) break;
+      } else {
+        for (int j = 0; j < turns; ++j) {
+          arena.execute([&] { tbb::parallel_for(w0, w1, [&](size_t i) { turn(i, j); }); });
+          if (std::all_of(done.begin(), done.end(), [](char d) { return d != 0; })) break;
+        }
       }
       if (s.stop && s.stop->load()) break;
     }
