@@ -26,7 +26,8 @@ class ExpZiggurat {
   /// 53 the position in it).
   double sample(Rng& rng) const {
     while (true) {
-      const uint64_t bits = (static_cast<uint64_t>(rng.next_u32()) << 32) | rng.next_u32();
+      const uint64_t hi = rng.next_u32();  // the high half first (operands of | are unordered)
+      const uint64_t bits = (hi << 32) | rng.next_u32();
       const int i = static_cast<int>(bits & 0xff);
       const double x = static_cast<double>(bits >> 11) * width_[i];  // u in [0, 1) times width
       if (x < x_[i + 1]) return x;  // under the curve: the rectangle left of the next edge

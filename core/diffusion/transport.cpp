@@ -56,7 +56,9 @@ Segment VoxelTransport::advance(Photon& p, Rng& rng) const {
     p.alive = false;
     return seg;
   }
-  p.d = hg_sample(p.d, g_, rng.uniform(), rng.uniform()).dir;
+  const double u2 = rng.uniform();  // the azimuth's first (a stated order, as GCC had it)
+  const double u1 = rng.uniform();
+  p.d = hg_sample(p.d, g_, u1, u2).dir;
   ++p.scatterings;
   return seg;
 }

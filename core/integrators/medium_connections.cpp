@@ -107,7 +107,9 @@ double VolPathIntegrator::direction_pdf(const DirectionMix& mix, const Vec3& x, 
 double VolPathIntegrator::sample_direction(const DirectionMix& mix, const Vec3& x, const Vec3& d,
                                            double g, Rng& rng, Vec3& w, double& pdf) const {
   if (!mix.active) {
-    const PhaseSample ps = hg_sample(d, g, rng.uniform(), rng.uniform());
+    const double u2 = rng.uniform();  // the azimuth's first (a stated order, as GCC had it)
+    const double u1 = rng.uniform();
+    const PhaseSample ps = hg_sample(d, g, u1, u2);
     w = ps.dir;
     pdf = ps.value;
     return 1.0;  // HG is sampled exactly

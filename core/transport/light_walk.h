@@ -180,7 +180,9 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
       v.sigma_ps = L.pulse.sigma_ps();
       v.chain = chain;
       if (!visit(static_cast<const LightVertex&>(v))) return;
-      ray = {x, hg_sample(ray.d, med.g(), rng.uniform(), rng.uniform()).dir};
+      const double u_phi = rng.uniform();  // the azimuth's first (a stated order, as GCC had it)
+      const double u_cos = rng.uniform();
+      ray = {x, hg_sample(ray.d, med.g(), u_cos, u_phi).dir};
       continue;
     }
 

@@ -382,7 +382,11 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
     p.alive = false;
     return StepEvent::Absorbed;
   }
-  p.d = hg_sample_direction(p.d, o.g, rng.uniform32(), rng.uniform32());
+  // Two draws in a stated order (as arguments their order would be the compiler's): the
+  // azimuth's first, as GCC evaluated them.
+  const double u_phi = rng.uniform32();
+  const double u_cos = rng.uniform32();
+  p.d = hg_sample_direction(p.d, o.g, u_cos, u_phi);
   ++p.scatterings;
   return StepEvent::Scattered;
 }
