@@ -225,6 +225,13 @@ Result simulate(const Setup& s) {
   Progress progress(own_photons, "tissue", s.quiet, "photons");
   tbb::task_arena arena(threads);
   const size_t wave = wave_chunks(threads);
+  // Calls f with the space the photons walk: the voxel medium's, or the labelled grid's.
+  auto with_space = [&](auto&& f) {
+    if (voxel_space)
+      f(*voxel_space);
+    else
+      f(space);
+  };
   for (int b = 0; b < batches; ++b) {
     uint64_t p0, p1;
     batch_range(b, p0, p1);
@@ -260,20 +267,16 @@ Result simulate(const Setup& s) {
         const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
         if (j == 0) {
           out.reset(labels, tpsf_size, ndet);
-          if (voxel_space)
-            launch_chunk(s, *voxel_space, emitter, q0, q1, walkers[k], out);
-          else
-            launch_chunk(s, space, emitter, q0, q1, walkers[k], out);
+          with_space(
+              [&](const auto& sp) { launch_chunk(s, sp, emitter, q0, q1, walkers[k], out); });
           tally[k].emplace(s, scale);
           tally[k]->start_chunk(out, static_cast<size_t>(q1 - q0));
         }
         // The thread's deposit queue is this task's until unbind: nothing in between may wait
         // on TBB (another task run meanwhile on this thread would share the queue).
         tally[k]->bind(thread_sums.local());
-        if (voxel_space)
-          walk_turn(s, *voxel_space, ws, j, turns, walkers[k], *tally[k], out);
-        else
-          walk_turn(s, space, ws, j, turns, walkers[k], *tally[k], out);
+        with_space(
+            [&](const auto& sp) { walk_turn(s, sp, ws, j, turns, walkers[k], *tally[k], out); });
         tally[k]->unbind();
         if (!walkers[k].empty() && j + 1 < turns) return true;
         tally[k]->end_chunk();
