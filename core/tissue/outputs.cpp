@@ -7,6 +7,7 @@
 #include "core/io/nifti.h"
 #include "core/io/npy.h"
 #include "core/tissue/pulse.h"
+#include "core/zeroed_array.h"
 
 namespace femto::tissue {
 
@@ -96,7 +97,8 @@ std::vector<std::string> write_outputs(const std::string& dir, const Setup& s, c
     const std::vector<size_t> shape{static_cast<size_t>(fg.n[0]), static_cast<size_t>(fg.n[1]),
                                     static_cast<size_t>(fg.n[2]), T};
     write_npy_float32(path("fluence.npy"), shape, r.fluence.data());
-    std::vector<float> buf(r.fluence.size());
+    std::vector<float> buf;
+    resize_in_huge_pages(buf, r.fluence.size());
     const float per_ps = static_cast<float>(1.0 / s.time.bin_width_ps);
     for (size_t i = 0; i < buf.size(); ++i) buf[i] = r.fluence[i] * per_ps;
     write_npy_float32(path("fluence_rate.npy"), shape, buf.data());

@@ -148,9 +148,10 @@ uint64_t memory_bytes(const Setup& s, int threads) {
   if (s.faces)
     for (int a = 0; a < 3; ++a)
       faces += 2 * static_cast<uint64_t>(s.volume.n[(a + 1) % 3]) * s.volume.n[(a + 2) % 3] * gates;
-  // Integer sums per thread and in total; float results; double sums of squares for errors.
-  uint64_t bytes =
-      (volume + faces) * 8 * (static_cast<uint64_t>(threads) + 1) + (volume + faces) * 4;
+  // Integer sums per thread (and of the batches so far, with errors); float results; double sums
+  // of squares for errors.
+  const uint64_t sums = static_cast<uint64_t>(threads) + (s.fluence_stderr ? 1 : 0);
+  uint64_t bytes = (volume + faces) * 8 * sums + (volume + faces) * 4;
   if (s.fluence_stderr) bytes += volume * (8 + 4);
   const uint64_t record = 8 * 2 + 4 * 2 + 8 * (s.volume.optics.size());
   if (!s.detectors.empty() && s.save_detected)
@@ -191,16 +192,17 @@ Result simulate(const Setup& s) {
     face_size[static_cast<size_t>(f)] =
         s.faces ? static_cast<size_t>(s.volume.n[b]) * s.volume.n[c] * gates : 0;
   }
-  tbb::enumerable_thread_specific<ThreadSums> thread_sums([&] {
+  // Zeros from the kernel, touched only where photons deposit (core/zeroed_array.h).
+  auto zeroed_sums = [&] {
     ThreadSums t;
-    t.fluence.assign(volume_size, 0);
-    for (size_t f = 0; f < 6; ++f) t.faces[f].assign(face_size[f], 0);
+    t.fluence = ZeroedArray<uint64_t>(volume_size);
+    for (size_t f = 0; f < 6; ++f) t.faces[f] = ZeroedArray<uint64_t>(face_size[f]);
     return t;
-  });
-  ThreadSums total;
-  total.fluence.assign(volume_size, 0);
-  for (size_t f = 0; f < 6; ++f) total.faces[f].assign(face_size[f], 0);
-  std::vector<double> sum2(s.fluence_stderr ? volume_size : 0, 0.0);
+  };
+  tbb::enumerable_thread_specific<ThreadSums> thread_sums(zeroed_sums);
+  // With standard errors, the sums of the batches so far (the threads' start again each batch).
+  ThreadSums total = s.fluence_stderr ? zeroed_sums() : ThreadSums{};
+  ZeroedArray<double> sum2(s.fluence_stderr ? volume_size : 0);
 
   ChunkSums all;
   all.reset(labels, tpsf_size, ndet);
@@ -377,15 +379,16 @@ Result simulate(const Setup& s) {
       r.tpsf_batches[static_cast<size_t>(b) * tpsf_size + i] = batch_tpsf[i];
     }
     // Integer sums of the threads: exact, so their order does not matter. Without standard
-    // errors the threads keep adding theirs until the last batch (the scale allows all photons).
-    if (!s.fluence_stderr && b + 1 < batches) continue;
+    // errors the threads keep adding theirs until the last batch (the scale allows all photons),
+    // and the sum over threads is made after it.
+    if (!s.fluence_stderr) continue;
     const double batch_n = static_cast<double>(p1 - p0);
     for (ThreadSums& ts : thread_sums) {
       for (size_t i = 0; i < volume_size; ++i) total.fluence[i] += ts.fluence[i];
       for (size_t f = 0; f < 6; ++f)
         for (size_t i = 0; i < face_size[f]; ++i) total.faces[f][i] += ts.faces[f][i];
     }
-    if (s.fluence_stderr) {
+    {
       // The batch's integer sum is the sum over threads; square its mean per photon.
       for (size_t i = 0; i < volume_size; ++i) {
         uint64_t v = 0;
@@ -400,6 +403,18 @@ Result simulate(const Setup& s) {
     }
   }
   progress.finish();
+  // Without standard errors: the other threads' sums added into this thread's (no third array).
+  const ThreadSums* summed = &total;
+  if (!s.fluence_stderr) {
+    ThreadSums& mine = thread_sums.local();
+    for (ThreadSums& ts : thread_sums) {
+      if (&ts == &mine) continue;
+      for (size_t i = 0; i < volume_size; ++i) mine.fluence[i] += ts.fluence[i];
+      for (size_t f = 0; f < 6; ++f)
+        for (size_t i = 0; i < face_size[f]; ++i) mine.faces[f][i] += ts.faces[f][i];
+    }
+    summed = &mine;
+  }
 
   const double N = static_cast<double>(s.photons);
   r.gates = gates;
@@ -421,31 +436,36 @@ Result simulate(const Setup& s) {
     // cell * gates + gate with cell = (i ny + j) nz + k.
     const FluenceGrid& fg = s.fluence_grid;
     const size_t slots = layout.slots, G = static_cast<size_t>(gates);
-    r.fluence.resize(fg.cells() * G);
-    if (s.fluence_stderr) r.fluence_err.resize(fg.cells() * G);
+    const size_t n = fg.cells() * G;
+    resize_in_huge_pages(r.fluence, n);
+    if (s.fluence_stderr) resize_in_huge_pages(r.fluence_err, n);
     const double B = batches, to_fluence = 1.0 / (scale * h.x * h.y * h.z);
-    size_t c = 0;
-    for (int i = 0; i < fg.n[0]; ++i)
-      for (int j = 0; j < fg.n[1]; ++j)
-        for (int k = 0; k < fg.n[2]; ++k, ++c) {
-          const size_t slot = layout.index(i, j, k);
-          for (size_t g = 0; g < G; ++g) {
-            const size_t q = g * slots + slot;
-            r.fluence[c * G + g] = static_cast<float>(static_cast<double>(total.fluence[q]) * unit);
-            if (!s.fluence_stderr) continue;
-            const double mean =
-                static_cast<double>(total.fluence[q]) / N;  // per photon, fixed units
-            const double var = B > 1 ? std::max(0.0, (sum2[q] - B * mean * mean) / (B - 1)) : 0.0;
-            r.fluence_err[c * G + g] = static_cast<float>(std::sqrt(var / B) * to_fluence);
+    const uint64_t* sums = summed->fluence.data();
+    // Slice by slice of x on every thread: each cell is written once, by one thread.
+    arena.execute([&] {
+      tbb::parallel_for(0, fg.n[0], [&](int i) {
+        size_t c = static_cast<size_t>(i) * fg.n[1] * fg.n[2];
+        for (int j = 0; j < fg.n[1]; ++j)
+          for (int k = 0; k < fg.n[2]; ++k, ++c) {
+            const size_t slot = layout.index(i, j, k);
+            for (size_t g = 0; g < G; ++g) {
+              const size_t q = g * slots + slot;
+              r.fluence[c * G + g] = static_cast<float>(static_cast<double>(sums[q]) * unit);
+              if (!s.fluence_stderr) continue;
+              const double mean = static_cast<double>(sums[q]) / N;  // per photon, fixed units
+              const double var = B > 1 ? std::max(0.0, (sum2[q] - B * mean * mean) / (B - 1)) : 0.0;
+              r.fluence_err[c * G + g] = static_cast<float>(std::sqrt(var / B) * to_fluence);
+            }
           }
-        }
+      });
+    });
   }
   const double area_pix = s.volume.voxel * s.volume.voxel;
   for (size_t f = 0; f < 6; ++f) {
     r.face_exitance[f].resize(face_size[f]);
     const double unit = 1.0 / (scale * N * area_pix * s.time.bin_width_ps);
     for (size_t i = 0; i < face_size[f]; ++i)
-      r.face_exitance[f][i] = static_cast<float>(static_cast<double>(total.faces[f][i]) * unit);
+      r.face_exitance[f][i] = static_cast<float>(static_cast<double>(summed->faces[f][i]) * unit);
   }
   // TPSF: exitance through the detector's disc, averaged over each gate; errors from batches.
   r.tpsf.assign(tpsf_size, 0.0);

@@ -13,6 +13,7 @@
 #include "core/tissue/chunk_sums.h"
 #include "core/tissue/setup.h"
 #include "core/transport/photon.h"
+#include "core/zeroed_array.h"
 #include "media/grid_medium.h"  // clamped_floor
 
 namespace femto::tissue {
@@ -46,8 +47,8 @@ struct Deposit {
 /// Integer sums of the volume tallies of one thread (fixed point: order-independent), and the
 /// queue of its deposits not yet added.
 struct ThreadSums {
-  std::vector<uint64_t> fluence;
-  std::array<std::vector<uint64_t>, 6> faces;
+  ZeroedArray<uint64_t> fluence;  // pages mapped as deposits first touch them
+  std::array<ZeroedArray<uint64_t>, 6> faces;
   std::vector<Deposit> queue;
 };
 

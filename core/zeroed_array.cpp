@@ -1,0 +1,51 @@
+#include "core/zeroed_array.h"
+
+#include <sys/mman.h>
+
+#include <cstdint>
+#include <new>
+
+namespace femto {
+
+namespace {
+constexpr size_t kHugePage = size_t{2} << 20;
+// Below this, 4 KiB pages cost little: no alignment slack, no advice.
+constexpr size_t kHugeFrom = 4 * kHugePage;
+}  // namespace
+
+void* map_zeroed(size_t bytes) {
+  if (bytes < kHugeFrom) {
+    void* p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    return p;
+  }
+  // Map 2 MiB more, keep the aligned part, give back the slack on both sides.
+  const size_t span = bytes + kHugePage;
+  void* raw = mmap(nullptr, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (raw == MAP_FAILED) throw std::bad_alloc();
+  const uintptr_t start = reinterpret_cast<uintptr_t>(raw);
+  const uintptr_t aligned = (start + kHugePage - 1) & ~(kHugePage - 1);
+  const uintptr_t stop = start + span, used_end = aligned + ((bytes + 4095) & ~size_t{4095});
+  if (aligned > start) munmap(raw, aligned - start);
+  if (stop > used_end) munmap(reinterpret_cast<void*>(used_end), stop - used_end);
+  void* p = reinterpret_cast<void*>(aligned);
+  advise_huge_pages(p, bytes);
+  return p;
+}
+
+void unmap_zeroed(void* p, size_t bytes) {
+  munmap(p, bytes);
+}
+
+void advise_huge_pages(void* p, size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  const uintptr_t start = reinterpret_cast<uintptr_t>(p);
+  const uintptr_t lo = (start + kHugePage - 1) & ~(kHugePage - 1);
+  const uintptr_t hi = (start + bytes) & ~(kHugePage - 1);
+  if (hi > lo) madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);  // a hint
+#else
+  (void)p, (void)bytes;
+#endif
+}
+
+}  // namespace femto
