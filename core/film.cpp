@@ -3,12 +3,14 @@
 #include <cmath>
 #include <limits>
 
+#include "core/zeroed_array.h"
+
 namespace femto {
 
 TransientFilm::TransientFilm(int width, int height, const TimeAxis& axis)
     : width_(width), height_(height), axis_(axis) {
   const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
-  transient_.assign(pixels * static_cast<size_t>(axis.bins) * 3, 0.0f);
+  resize_in_huge_pages(transient_, pixels * static_cast<size_t>(axis.bins) * 3);
   steady_.assign(pixels * 3, 0.0f);
   before_.assign(pixels * 3, 0.0f);
   after_.assign(pixels * 3, 0.0f);

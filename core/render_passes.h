@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/render.h"
+#include "core/zeroed_array.h"
 
 namespace femto::passes {
 
@@ -41,7 +42,7 @@ inline RenderState start_state(const RenderOptions& opt, IntegratorKind kind, bo
     s.kernel = kernel;
     s.units_total = units_total;
     s.stride = stride;
-    s.sums.assign(pixels * static_cast<size_t>(stride), 0.0);
+    resize_in_huge_pages(s.sums, pixels * static_cast<size_t>(stride));  // few page faults
     if (kernel) s.bandwidth_ps.assign(pixels, 0.0f);
   }
   s.sessions += 1;
