@@ -9,8 +9,13 @@ namespace femto {
 
 namespace {
 constexpr size_t kHugePage = size_t{2} << 20;
-// Below this, 4 KiB pages cost little: no alignment slack, no advice.
-constexpr size_t kHugeFrom = 4 * kHugePage;
+// From half a huge page on, whole 2 MiB pages (the rest of the last one unused): each page
+// fault maps 2 MiB instead of 4 KiB.
+constexpr size_t kHugeFrom = kHugePage / 2;
+
+size_t mapped_bytes(size_t bytes) {
+  return bytes < kHugeFrom ? bytes : (bytes + kHugePage - 1) & ~(kHugePage - 1);
+}
 }  // namespace
 
 void* map_zeroed(size_t bytes) {
@@ -20,21 +25,21 @@ void* map_zeroed(size_t bytes) {
     return p;
   }
   // Map 2 MiB more, keep the aligned part, give back the slack on both sides.
-  const size_t span = bytes + kHugePage;
+  const size_t used = mapped_bytes(bytes), span = used + kHugePage;
   void* raw = mmap(nullptr, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
   if (raw == MAP_FAILED) throw std::bad_alloc();
   const uintptr_t start = reinterpret_cast<uintptr_t>(raw);
   const uintptr_t aligned = (start + kHugePage - 1) & ~(kHugePage - 1);
-  const uintptr_t stop = start + span, used_end = aligned + ((bytes + 4095) & ~size_t{4095});
+  const uintptr_t stop = start + span, used_end = aligned + used;
   if (aligned > start) munmap(raw, aligned - start);
   if (stop > used_end) munmap(reinterpret_cast<void*>(used_end), stop - used_end);
   void* p = reinterpret_cast<void*>(aligned);
-  advise_huge_pages(p, bytes);
+  advise_huge_pages(p, used);
   return p;
 }
 
 void unmap_zeroed(void* p, size_t bytes) {
-  munmap(p, bytes);
+  munmap(p, mapped_bytes(bytes));
 }
 
 void advise_huge_pages(void* p, size_t bytes) {

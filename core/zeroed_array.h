@@ -11,7 +11,8 @@
 
 namespace femto {
 
-/// `bytes` of zeros, 2 MiB-aligned when large; nothing is touched. Throws std::bad_alloc.
+/// `bytes` of zeros, in whole 2 MiB-aligned pages from 1 MiB on; nothing is touched. Throws
+/// std::bad_alloc.
 void* map_zeroed(size_t bytes);
 void unmap_zeroed(void* p, size_t bytes);
 /// Asks for 2 MiB pages in the whole 2 MiB-aligned part of [p, p + bytes) that is not touched

@@ -234,6 +234,9 @@ Result simulate(const Setup& s) {
     else
       f(space);
   };
+  // The photons of a wave's chunks between turns: kept for the whole run, so that each chunk
+  // reuses its slot's memory (fresh memory costs page faults).
+  std::vector<std::vector<Walker>> walkers(wave);
   for (int b = 0; b < batches; ++b) {
     uint64_t p0, p1;
     batch_range(b, p0, p1);
@@ -254,7 +257,6 @@ Result simulate(const Setup& s) {
     const bool gate_stops = threads == 1 || owned.size() >= 8 * static_cast<size_t>(threads);
     for (size_t w0 = 0; w0 < owned.size(); w0 += wave) {
       const size_t w1 = std::min(owned.size(), w0 + wave);
-      std::vector<std::vector<Walker>> walkers(w1 - w0);
       std::vector<std::optional<Tally>> tally(w1 - w0);
       std::vector<char> done(w1 - w0, 0);
       // Turn j of chunk owned[i]; false once the chunk is done.
@@ -268,6 +270,7 @@ Result simulate(const Setup& s) {
         ChunkSums& out = chunk[c];
         const uint64_t q0 = p0 + c * kChunk, q1 = std::min(p1, q0 + kChunk);
         if (j == 0) {
+          walkers[k].clear();  // a stopped run's wave may leave photons here
           out.reset(labels, tpsf_size, ndet);
           with_space(
               [&](const auto& sp) { launch_chunk(s, sp, emitter, q0, q1, walkers[k], out); });
@@ -283,7 +286,7 @@ Result simulate(const Setup& s) {
         if (!walkers[k].empty() && j + 1 < turns) return true;
         tally[k]->end_chunk();
         tally[k].reset();
-        std::vector<Walker>().swap(walkers[k]);
+        walkers[k].clear();
         done[k] = 1;
         progress.add(q1 - q0);
         if (s.photons_done) s.photons_done->fetch_add(q1 - q0);
