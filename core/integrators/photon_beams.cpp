@@ -33,13 +33,9 @@ void outward(double lo, double hi, float& flo, float& fhi) {
   fhi = std::nextafter(static_cast<float>(hi + pad), std::numeric_limits<float>::infinity());
 }
 
-/// A piece's box during the build; the items themselves are partitioned (not an index array), so
-/// each node's pieces lie contiguous in memory.
-struct BuildItem {
-  float lo[3], hi[3];
-  float centre[3];
-  uint32_t piece;  ///< index into the unsorted pieces, also the tie-break of median splits
-};
+/// The items themselves are partitioned (not an index array), so each node's pieces lie
+/// contiguous in memory.
+using BuildItem = BeamBuildItem;
 
 // Binned surface-area heuristic: camera segments are long and cross the beams' bundles, so the
 // expected number of boxes a segment meets (proportional to their surface area) is what a split
@@ -197,11 +193,20 @@ void BeamBvh::build(std::vector<Beam> beams, double radius) {
   pieces_.clear();
   nodes_.clear();
   if (beams_.empty()) return;
-  std::vector<BuildItem> items;
+  auto pieces_of = [&](const Beam& b) {
+    const double want = std::ceil(b.length / (4.0 * radius));
+    return static_cast<uint32_t>(std::clamp(want, 1.0, double{kMaxPieces}));
+  };
+  // Room for all pieces, so that their lists do not grow (and move) during the build.
+  size_t total = 0;
+  for (const Beam& b : beams_) total += pieces_of(b);
+  std::vector<BuildItem>& items = items_;
+  items.clear();
+  items.reserve(total);
+  pieces_.reserve(total);
   for (size_t i = 0; i < beams_.size(); ++i) {
     const Beam& b = beams_[i];
-    const double want = std::ceil(b.length / (4.0 * radius));
-    const auto n = static_cast<uint32_t>(std::clamp(want, 1.0, double{kMaxPieces}));
+    const uint32_t n = pieces_of(b);
     float v_prev = 0.0f;
     for (uint32_t k = 0; k < n; ++k) {
       // Shared float ends: piece k's v1 is piece k + 1's v0, so the ranges tile the beam.
@@ -227,14 +232,15 @@ void BeamBvh::build(std::vector<Beam> beams, double radius) {
   nodes_.reserve(2 * pieces_.size() / kLeafSize + 2);
   nodes_.push_back({});
   build_subtree(items.data(), 0, static_cast<uint32_t>(items.size()), 0, nodes_, 0);
-  std::vector<Piece> sorted(pieces_.size());
-  for (size_t i = 0; i < items.size(); ++i) sorted[i] = pieces_[items[i].piece];
-  pieces_ = std::move(sorted);
+  sorted_.resize(pieces_.size());
+  for (size_t i = 0; i < items.size(); ++i) sorted_[i] = pieces_[items[i].piece];
+  pieces_.swap(sorted_);  // the unsorted list's memory is the next build's sorted_
 }
 
 uint64_t BeamBvh::memory_bytes() const {
-  return beams_.capacity() * sizeof(Beam) + pieces_.capacity() * sizeof(Piece) +
-         nodes_.capacity() * sizeof(Node);
+  return beams_.capacity() * sizeof(Beam) +
+         (pieces_.capacity() + sorted_.capacity()) * sizeof(Piece) +
+         nodes_.capacity() * sizeof(Node) + items_.capacity() * sizeof(BuildItem);
 }
 
 void BeamGather::gather(int m, const Ray& ray, double s_max, const RGB& beta, double t,

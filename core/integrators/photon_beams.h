@@ -30,6 +30,13 @@ struct Beam {
   int medium = 0;       ///< region it lies in
 };
 
+/// A beam piece's box while BeamBvh builds its tree (the items are partitioned in place).
+struct BeamBuildItem {
+  float lo[3], hi[3];
+  float centre[3];
+  uint32_t piece;  ///< index into the unsorted pieces, also the tie-break of median splits
+};
+
 /// Bounding-volume hierarchy over beams thickened by R, for segment queries; built per pass.
 /// A long beam is cut into pieces of about 4 R (at most kMaxPieces) so that the boxes stay tight
 /// around slanted beams; a crossing belongs to the one piece whose range holds its closest
@@ -64,6 +71,10 @@ class BeamBvh {
   std::vector<Beam> beams_;
   std::vector<Piece> pieces_;
   std::vector<Node> nodes_;
+  // The build's scratch (boxes of the pieces, the pieces in tree order), kept from pass to pass
+  // with the arrays above: a pass's build reuses their memory (fresh memory costs page faults).
+  std::vector<BeamBuildItem> items_;
+  std::vector<Piece> sorted_;
 };
 
 /// What a camera ray needs to gather one pass's beams.
@@ -107,10 +118,11 @@ std::vector<Beam> trace_beams(const Scene& scene, uint64_t seed, int pass, int64
                               const CausticAim* aim = nullptr);
 
 /// Memory of one pass holding `beams` beams: the traced lists and the tree's copy, and at most
-/// kMaxPieces pieces per beam with their build boxes and nodes (40 + 32 bytes a piece, and up to
-/// half the nodes again, with growth, in the right halves built in parallel).
+/// kMaxPieces pieces per beam (twice: unsorted and in tree order) with their build boxes and
+/// nodes (40 + 32 bytes a piece, and up to half the nodes again, with growth, in the right
+/// halves built in parallel).
 inline uint64_t beam_pass_bytes(uint64_t beams) {
-  return beams * (3 * sizeof(Beam) + BeamBvh::kMaxPieces * (sizeof(BeamBvh::Piece) + 104));
+  return beams * (3 * sizeof(Beam) + BeamBvh::kMaxPieces * (2 * sizeof(BeamBvh::Piece) + 104));
 }
 
 template <class F>
