@@ -15,6 +15,8 @@ namespace femto {
 /// std::bad_alloc.
 void* map_zeroed(size_t bytes);
 void unmap_zeroed(void* p, size_t bytes);
+/// False in sanitizer builds: there the arrays come from calloc, whose bounds the sanitizer checks.
+bool zeroed_arrays_in_pages();
 /// Asks for 2 MiB pages in the whole 2 MiB-aligned part of [p, p + bytes) that is not touched
 /// yet (e.g. a std::vector's buffer after reserve()): a hint, harmless if not granted.
 void advise_huge_pages(void* p, size_t bytes);
