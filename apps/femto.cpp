@@ -10,6 +10,7 @@
 #include "core/distributed/comm.h"
 #include "core/distributed/job.h"
 #include "core/error.h"
+#include "core/memory_usage.h"
 #include "femto_version.h"
 
 namespace {
@@ -44,6 +45,7 @@ void report(const char* kind, const char* what) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  femto::reuse_freed_memory();  // per-pass lists reuse their pages (page faults are costly)
   // Under mpirun: signals go to femto's waiting thread (blocked before MPI starts its threads),
   // then the process joins the job.
   if (femto::distributed::launched_by_mpi()) femto::stop_signals::start();

@@ -2,6 +2,9 @@
 
 #include <cstdio>
 #include <cstring>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace femto {
 
@@ -25,5 +28,12 @@ uint64_t status_kib(const char* key) {
 
 uint64_t current_rss_bytes() { return status_kib("VmRSS"); }
 uint64_t peak_rss_bytes() { return status_kib("VmHWM"); }
+
+void reuse_freed_memory() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's largest
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
+}
 
 }  // namespace femto
