@@ -3,7 +3,7 @@
 // memory straight from the kernel, which is zero already and mapped on first touch, in 2 MiB
 // pages where the kernel grants them (Linux transparent huge pages, `madvise` mode). On virtual
 // machines a 4 KiB page fault can cost 10-20 us: 86 MiB of sums zeroed by std::vector then take
-// about 0.4 s of faults, against about 1 ms in 2 MiB pages (docs/PERFORMANCE.md, "Page faults").
+// about 0.4 s of faults, against 43 faults in 2 MiB pages (docs/PERFORMANCE.md, "Page faults").
 #include <cstddef>
 #include <cstdint>
 #include <utility>
