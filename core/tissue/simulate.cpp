@@ -386,19 +386,13 @@ Result simulate(const Setup& s) {
     // and the sum over threads is made after it.
     if (!s.fluence_stderr) continue;
     const double batch_n = static_cast<double>(p1 - p0);
-    for (ThreadSums& ts : thread_sums) {
-      for (size_t i = 0; i < volume_size; ++i) total.fluence[i] += ts.fluence[i];
-      for (size_t f = 0; f < 6; ++f)
-        for (size_t i = 0; i < face_size[f]; ++i) total.faces[f][i] += ts.faces[f][i];
-    }
-    {
-      // The batch's integer sum is the sum over threads; square its mean per photon.
-      for (size_t i = 0; i < volume_size; ++i) {
-        uint64_t v = 0;
-        for (ThreadSums& ts : thread_sums) v += ts.fluence[i];
-        const double m = static_cast<double>(v) / batch_n;
-        sum2[i] += m * m;
-      }
+    for (const ThreadSums& ts : thread_sums) total.add(ts);
+    // The batch's integer sum is the sum over threads; square its mean per photon.
+    for (size_t i = 0; i < volume_size; ++i) {
+      uint64_t v = 0;
+      for (ThreadSums& ts : thread_sums) v += ts.fluence[i];
+      const double m = static_cast<double>(v) / batch_n;
+      sum2[i] += m * m;
     }
     for (ThreadSums& ts : thread_sums) {
       std::fill(ts.fluence.begin(), ts.fluence.end(), 0);
@@ -410,12 +404,8 @@ Result simulate(const Setup& s) {
   const ThreadSums* summed = &total;
   if (!s.fluence_stderr) {
     ThreadSums& mine = thread_sums.local();
-    for (ThreadSums& ts : thread_sums) {
-      if (&ts == &mine) continue;
-      for (size_t i = 0; i < volume_size; ++i) mine.fluence[i] += ts.fluence[i];
-      for (size_t f = 0; f < 6; ++f)
-        for (size_t i = 0; i < face_size[f]; ++i) mine.faces[f][i] += ts.faces[f][i];
-    }
+    for (const ThreadSums& ts : thread_sums)
+      if (&ts != &mine) mine.add(ts);
     summed = &mine;
   }
 

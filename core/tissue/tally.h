@@ -50,6 +50,12 @@ struct ThreadSums {
   ZeroedArray<uint64_t> fluence;  // pages mapped as deposits first touch them
   std::array<ZeroedArray<uint64_t>, 6> faces;
   std::vector<Deposit> queue;
+  /// Adds another thread's sums (of the same shape) to these.
+  void add(const ThreadSums& o) {
+    for (size_t i = 0; i < fluence.size(); ++i) fluence[i] += o.fluence[i];
+    for (size_t f = 0; f < faces.size(); ++f)
+      for (size_t i = 0; i < faces[f].size(); ++i) faces[f][i] += o.faces[f][i];
+  }
 };
 
 /// The tallies of the photon walks of one chunk, plugged into walk_step's loop. The chunk's sums
