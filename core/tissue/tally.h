@@ -218,7 +218,7 @@ class Tally {
   // [sa, sb] gets w0 (F(sb) - F(sa)), F = decay_integral: each boundary's F on its own, so the
   // pieces do not wait for one another. The slot moves by one axis's term per face.
   void fluence_faces(const Segment& seg, const VoxelCrossings& vc) {
-    const int step[3] = {seg.d.x > 0 ? 1 : -1, seg.d.y > 0 ? 1 : -1, seg.d.z > 0 ? 1 : -1};
+    const double d[3] = {seg.d.x, seg.d.y, seg.d.z};  // a face's step: only for axes crossed
     int c[3] = {seg.cell[0], seg.cell[1], seg.cell[2]};
     size_t slot = gate_offset_ + part_[0][static_cast<size_t>(c[0])] +
                   part_[1][static_cast<size_t>(c[1])] + part_[2][static_cast<size_t>(c[2])];
@@ -229,7 +229,7 @@ class Tally {
       Fa = Fb;
       const int a = vc.axis[q];
       const size_t* part = part_[static_cast<size_t>(a)].data();
-      const int next = c[a] + step[a];
+      const int next = c[a] + (d[a] > 0 ? 1 : -1);
       slot += part[next] - part[c[a]];  // unsigned wrap-around moves the slot either way
       c[a] = next;
     }

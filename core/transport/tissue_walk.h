@@ -160,38 +160,6 @@ double march_to_change(const LabelVolume& vol, const Photon& p, double s_stop, i
   return s;
 }
 
-/// The voxel faces crossed by the piece p.x + p.d s, s in [0, s_stop), when every voxel on the
-/// way has p's label (inside its safe box): the march's faces, in its order and at its
-/// distances, but the next axis is chosen by compares and selects, not by branches (for a
-/// predictor the choice is a coin flip, missed about once per face). For the steps that
-/// crossings_closed_form declines (two or more faces on an axis).
-inline void crossings_in_safe_box(const LabelVolume& vol, const Photon& p, double s_stop,
-                                  int end_cell[3], VoxelCrossings& crossed) {
-  const VoxelDda dda(p.x, p.d, p.cell, vol.origin, Vec3(vol.voxel));
-  // In registers: an array indexed by the axis would chain each face through a store and a load.
-  double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
-  const double dx = dda.t_delta[0], dy = dda.t_delta[1], dz = dda.t_delta[2];
-  int cx = dda.cell[0], cy = dda.cell[1], cz = dda.cell[2];
-  int count = 0;
-  while (true) {
-    // VoxelDda::axis(): x if tx < ty and tx < tz, else y if ty < tz (and not tx < ty), else z.
-    const bool x_first = (tx < ty) & (tx < tz);
-    const bool y_first = !(tx < ty) & (ty < tz);
-    const bool z_first = !x_first & !y_first;
-    const int a = 2 - 2 * int{x_first} - int{y_first};
-    const double s = select_min(select_min(tx, ty), tz);  // t of axis a: ties have one value
-    if (s >= s_stop) break;
-    if (count < VoxelCrossings::kMax)
-      crossed.s[count] = s, crossed.axis[count] = static_cast<int8_t>(a);
-    ++count;
-    tx = select_if(x_first, tx + dx, tx), cx += int{x_first} * dda.step[0];
-    ty = select_if(y_first, ty + dy, ty), cy += int{y_first} * dda.step[1];
-    tz = select_if(z_first, tz + dz, tz), cz += int{z_first} * dda.step[2];
-  }
-  crossed.count = count;
-  end_cell[0] = cx, end_cell[1] = cy, end_cell[2] = cz;
-}
-
 /// Puts p exactly on the face of its voxel on `axis` that it moves towards (no drift) and gives
 /// the voxel beyond that face.
 inline void face_neighbour(const LabelVolume& vol, Photon& p, int axis, int next[3]) {
@@ -260,10 +228,11 @@ class LabelSpace {
     const int safe = safe_[vol_.index(p.cell[0], p.cell[1], p.cell[2])];
     const Vec3 x1 = p.x + p.d * s_stop;
     if (inside_safe_box(vol_, p.cell, safe, x1, margin_)) {
-      if (crossed && crossings_closed_form(vol_, p.x, p.d, p.cell, s_stop, end_cell, *crossed))
-        return std::numeric_limits<double>::infinity();
       if (crossed) {  // the faces for a tally; every voxel on the way has the label
-        crossings_in_safe_box(vol_, p, s_stop, end_cell, *crossed);
+        AxisFaces f;
+        if (!crossings_closed_form(vol_, p.x, p.d, p.cell, s_stop, end_cell, *crossed, f) &&
+            !crossings_two_per_axis(f, p.cell, s_stop, end_cell, *crossed))
+          crossings_from_axis_faces(f, p.cell, s_stop, end_cell, *crossed);
         return std::numeric_limits<double>::infinity();
       }
       for (int a = 0; a < 3; ++a)
