@@ -195,6 +195,14 @@ TEST_CASE("closed-form voxel crossings are the faces the march crosses") {
       CHECK(got.axis[q] == ref.axis[q]);
     }
     for (int a = 0; a < 3; ++a) CHECK(end[a] == end_ref[a]);
+    // The walk's entry point takes the same stage.
+    VoxelCrossings walk;
+    int end_walk[3];
+    crossings_in_safe_box(v, p.x, p.d, p.cell, s_stop, end_walk, walk);
+    REQUIRE(walk.count == got.count);
+    for (int q = 0; q < got.count; ++q)
+      CHECK((walk.s[q] == got.s[q] && walk.axis[q] == got.axis[q]));
+    for (int a = 0; a < 3; ++a) CHECK(end_walk[a] == end[a]);
   }
   CHECK(closed > 38000);
   CHECK(two > 4500);

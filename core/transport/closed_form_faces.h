@@ -27,6 +27,8 @@ struct AxisFaces {
   double t[4];  // a fourth slot for the AVX stage's padding lane
   double delta[4];
   int up = 0;
+  /// The voxel step on axis a: +1 up, -1 down.
+  int step(int a) const { return 2 * ((up >> a) & 1) - 1; }
 };
 
 /// The per-axis part, one axis at a time: f.t[a] = the distance along dir from x to the face of
@@ -154,7 +156,7 @@ inline bool crossings_two_per_axis(const AxisFaces& f, const int cell[3], double
     u[a] = ta;
     u[3 + a] = select_if(c2, tb, kInf);
     count += int{c1} + int{c2};
-    end_cell[a] = cell[a] + (int{c1} + int{c2}) * (2 * ((f.up >> a) & 1) - 1);
+    end_cell[a] = cell[a] + (int{c1} + int{c2}) * f.step(a);
   }
   if (!fits) return false;
   // An optimal sorting network for six (12 compare-exchanges, depth 5).
@@ -178,7 +180,7 @@ inline void crossings_from_axis_faces(const AxisFaces& f, const int cell[3], dou
   // In registers: an array indexed by the axis would chain each face through a store and a load.
   double tx = f.t[0], ty = f.t[1], tz = f.t[2];
   const double dx = f.delta[0], dy = f.delta[1], dz = f.delta[2];
-  const int sx = 2 * (f.up & 1) - 1, sy = 2 * ((f.up >> 1) & 1) - 1, sz = 2 * ((f.up >> 2) & 1) - 1;
+  const int sx = f.step(0), sy = f.step(1), sz = f.step(2);
   int cx = cell[0], cy = cell[1], cz = cell[2];
   int count = 0;
   while (true) {
@@ -198,6 +200,17 @@ inline void crossings_from_axis_faces(const AxisFaces& f, const int cell[3], dou
   }
   crossed.count = count;
   end_cell[0] = cx, end_cell[1] = cy, end_cell[2] = cz;
+}
+
+/// All voxel faces crossed by the piece x + dir s, s in [0, s_stop), inside a safe box (every
+/// voxel on the way has the label of `cell`), by the cheapest of the stages above that holds.
+inline void crossings_in_safe_box(const LabelVolume& vol, const Vec3& x, const Vec3& dir,
+                                  const int cell[3], double s_stop, int end_cell[3],
+                                  VoxelCrossings& crossed) {
+  AxisFaces f;
+  if (!crossings_closed_form(vol, x, dir, cell, s_stop, end_cell, crossed, f) &&
+      !crossings_two_per_axis(f, cell, s_stop, end_cell, crossed))
+    crossings_from_axis_faces(f, cell, s_stop, end_cell, crossed);
 }
 
 }  // namespace femto

@@ -229,10 +229,7 @@ class LabelSpace {
     const Vec3 x1 = p.x + p.d * s_stop;
     if (inside_safe_box(vol_, p.cell, safe, x1, margin_)) {
       if (crossed) {  // the faces for a tally; every voxel on the way has the label
-        AxisFaces f;
-        if (!crossings_closed_form(vol_, p.x, p.d, p.cell, s_stop, end_cell, *crossed, f) &&
-            !crossings_two_per_axis(f, p.cell, s_stop, end_cell, *crossed))
-          crossings_from_axis_faces(f, p.cell, s_stop, end_cell, *crossed);
+        crossings_in_safe_box(vol_, p.x, p.d, p.cell, s_stop, end_cell, *crossed);
         return std::numeric_limits<double>::infinity();
       }
       for (int a = 0; a < 3; ++a)
