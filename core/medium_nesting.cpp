@@ -38,6 +38,15 @@ Box3 bounds_of(const ShapeDesc& s) {
   return b;
 }
 
+}  // namespace
+
+void shape_bounds(const ShapeDesc& s, Vec3& lo, Vec3& hi) {
+  const Box3 b = bounds_of(s);
+  lo = b.lo, hi = b.hi;
+}
+
+namespace {
+
 bool is_sphere(const ShapeDesc& s) {
   return s.type == ShapeDesc::Type::Sphere;
 }

@@ -13,6 +13,9 @@ double distance_to_triangles(const ShapeDesc& s, const Vec3& p);
 /// Whether shape s bounds a region of its own medium (a `medium`, or a refracting material).
 bool bounds_a_medium(const ShapeDesc& s);
 
+/// The axis-aligned bounding box [lo, hi] of shape s.
+void shape_bounds(const ShapeDesc& s, Vec3& lo, Vec3& hi);
+
 /// For every shape, the index of the innermost medium-bounding shape that strictly encloses it,
 /// or -1 when the global medium surrounds it. Throws InputError, naming both shapes, when the
 /// surfaces of two medium-bounding shapes cross or touch (nesting must be strict).

@@ -52,19 +52,23 @@ Scene::Scene(SceneDesc desc)
   }
   // Media nest: a shape's outside is the inside of the innermost medium shape around it, and a
   // shape that bounds no medium has that medium on both sides.
-  const std::vector<int> enclosing = enclosing_shapes(desc_);
+  enclosing_ = enclosing_shapes(desc_);
   outside_of_.assign(n, outside_);
   for (size_t i = 0; i < n; ++i) {
-    const int e = enclosing[i];
+    const int e = enclosing_[i];
     if (e >= 0) outside_of_[i] = inside_[static_cast<size_t>(e)];
     if (!bounds_a_medium(desc_.shapes[i])) inside_[i] = outside_of_[i];
   }
-  const int around_camera = innermost_shape_at(desc_, enclosing, desc_.camera.position);
-  camera_medium_ = around_camera >= 0 ? inside_[static_cast<size_t>(around_camera)] : outside_;
+  camera_medium_ = medium_at(desc_.camera.position);
   const Vec3 lo = geometry_.bounds_min(), hi = geometry_.bounds_max();
   const double extent = std::max({max_abs_component(lo), max_abs_component(hi),
                                   max_abs_component(desc_.camera.position), 1.0});
   ray_eps_ = 2e-6 * extent;  // a few float ulps of Embree's single-precision vertices
+}
+
+int Scene::medium_at(const Vec3& p) const {
+  const int around = innermost_shape_at(desc_, enclosing_, p);
+  return around >= 0 ? inside_[static_cast<size_t>(around)] : outside_;
 }
 
 }  // namespace femto

@@ -39,6 +39,9 @@ class Scene {
   }
   /// Medium the camera sits in (the innermost closed medium shape around it).
   int camera_medium() const { return camera_medium_; }
+  /// Medium at point p: the inside of the innermost closed medium shape holding it strictly,
+  /// else the global medium.
+  int medium_at(const Vec3& p) const;
   /// Whether any shape is an index-matched boundary (shadow rays must then walk through them).
   bool has_null_boundaries() const { return has_null_boundaries_; }
   /// Offset used to leave a surface without hitting it again, mm.
@@ -53,6 +56,7 @@ class Scene {
   std::vector<std::unique_ptr<GridMedium>> grids_;
   std::vector<int> inside_;
   std::vector<int> outside_of_;
+  std::vector<int> enclosing_;  // enclosing_shapes(desc_)
   int outside_ = 0;
   int camera_medium_ = 0;
   double ray_eps_ = 1e-5;

@@ -1,5 +1,6 @@
 #include "core/integrators/volpath.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -7,6 +8,7 @@
 #include "core/integrators/connection_choice.h"
 #include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
+#include "core/medium_nesting.h"
 #include "core/sampling.h"
 #include "media/phase_hg.h"
 
@@ -32,6 +34,33 @@ VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& f
       total += lights.pmf(i);
     }
   for (double& p : point_pmf_) p /= total;
+  // connection_choice.h, third rule: no light inside a medium that scatters, and the media
+  // thinner than kThinDepth across the bounding box of their shapes (the global medium is not).
+  const std::vector<Medium>& media = scene.media();
+  bool outside = !point_lights_.empty();
+  for (int i : point_lights_)
+    outside = outside &&
+              !media[static_cast<size_t>(scene.medium_at(lights.light(i).position))].interacts();
+  thin_media_.assign(media.size(), 0);
+  if (!outside) return;
+  std::vector<Vec3> lo(media.size(), Vec3(kInf)), hi(media.size(), Vec3(-kInf));
+  const std::vector<ShapeDesc>& shapes = scene.desc().shapes;
+  for (size_t i = 0; i < shapes.size(); ++i) {
+    if (!bounds_a_medium(shapes[i])) continue;
+    const size_t m = static_cast<size_t>(scene.inside_medium(static_cast<int>(i)));
+    Vec3 a, b;
+    shape_bounds(shapes[i], a, b);
+    lo[m] = vmin(lo[m], a), hi[m] = vmax(hi[m], b);
+  }
+  for (size_t m = 0; m < media.size(); ++m) {
+    const Medium& med = media[m];
+    if (static_cast<int>(m) == scene.global_medium() || !med.interacts() || !(lo[m].x <= hi[m].x))
+      continue;
+    const double width = std::min({hi[m].x - lo[m].x, hi[m].y - lo[m].y, hi[m].z - lo[m].z});
+    const double sigma_t =
+        med.type == Medium::Type::Grid ? med.grid->mean_sigma_t() : med.homogeneous.sigma_t();
+    thin_media_[m] = sigma_t * width < kThinDepth;
+  }
 }
 
 void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
@@ -50,13 +79,13 @@ bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
 }
 
 bool VolPathIntegrator::ConnectedSegment::mis_with_collisions(const Light& light) const {
-  return time_mis && lights_from_start(ray_ptr->o, ray_ptr->d, light.position);
+  return time_mis && (thin || lights_from_start(ray_ptr->o, ray_ptr->d, light.position));
 }
 
-void VolPathIntegrator::plan_segment(const Medium& med, const Ray& ray, double s_surf, double t,
-                                     double t_factor, bool camera_segment,
+void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, double s_surf,
+                                     double t, double t_factor, bool camera_segment,
                                      ConnectedSegment& segment) const {
-  segment.active = segment.all = segment.decided = segment.time_mis = false;
+  segment.active = segment.all = segment.decided = segment.time_mis = segment.thin = false;
   segment.lp_target.reset();
   if (med.connection == ConnectionSampling::Collision || point_lights_.empty() || !med.interacts())
     return;
@@ -70,8 +99,12 @@ void VolPathIntegrator::plan_segment(const Medium& med, const Ray& ray, double s
     return;
   }
   segment.sigma_t = spread_sigma_t(med, ray.o);
-  segment.time_mis = camera_segment && med.strategy.kind == DistanceSampling::Mfp &&
-                     starved_segment(s_surf, kSpeedOfLight * (t_cut_ - t), segment.sigma_t);
+  const double budget = kSpeedOfLight * (t_cut_ - t);
+  const bool mfp = med.strategy.kind == DistanceSampling::Mfp;
+  segment.time_mis = camera_segment && mfp && starved_segment(s_surf, budget, segment.sigma_t);
+  segment.thin = !segment.time_mis && mfp && thin_media_[static_cast<size_t>(m)] &&
+                 thin_segment(s_surf, budget, segment.sigma_t);
+  segment.time_mis = segment.time_mis || segment.thin;
   const LightSet& lights = scene_.lights();
   for (int li : point_lights_)
     if (auto_connects(lights.light(li), ray.o, ray.d, s_surf, segment.sigma_t)) {
@@ -235,7 +268,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
                               : 0.0;
       const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next, q_tu);
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
-      plan_segment(med, ray, s_surf, t, t_dropped, on_camera_segment, segment);
+      plan_segment(med, m, ray, s_surf, t, t_dropped, on_camera_segment, segment);
       if ((segment.active || segment.time_mis) && medium_light)
         estimate_segment(med, m, segment, beta, rng, acc, stats);
       // Angular direction sampling: the next segment's distance draw is made now so that every

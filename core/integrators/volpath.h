@@ -90,6 +90,10 @@ class VolPathIntegrator {
     /// `covers` leaves to the collisions also get one line-to-point connection, and the two
     /// strategies share that light by the balance heuristic (connection_choice.h).
     bool time_mis = false;
+    /// time_mis on an optically thin segment with every point light outside the scattering
+    /// media (connection_choice.h, third rule): for every such light, not only those behind the
+    /// segment's start.
+    bool thin = false;
     // Set by plan_segment when a flag is: not initialised here, so a path's plan costs no
     // zeroing.
     const Ray* ray_ptr;
@@ -103,11 +107,12 @@ class VolPathIntegrator {
     std::optional<LineToPointTarget> lp_target;
   };
   /// The segment's connection plan, decided once per segment (and without random draws, so a
-  /// segment that connects nothing costs a few flops). t, t_factor: as for estimate_segment.
+  /// segment that connects nothing costs a few flops). m: the index of `med` in the scene's
+  /// media. t, t_factor: as for estimate_segment.
   /// Fills the path's one `segment`, resetting only its flags: the rest is read only when a flag
   /// is set, and zeroing the whole struct per segment cost 6% of a render.
-  void plan_segment(const Medium& med, const Ray& ray, double s_surf, double t, double t_factor,
-                    bool camera_segment, ConnectedSegment& segment) const;
+  void plan_segment(const Medium& med, int m, const Ray& ray, double s_surf, double t,
+                    double t_factor, bool camera_segment, ConnectedSegment& segment) const;
   /// A segment's line-to-point connection to light L (narrow: with its window).
   LineToPointTarget line_to_point_target(const Medium& med, const ConnectedSegment& segment,
                                          const Light& L, bool narrow_window) const;
@@ -156,6 +161,9 @@ class VolPathIntegrator {
   bool unwarp_;
   double t_cut_;
   std::vector<int> point_lights_;  ///< point and spot lights: targets of angular sampling
+  /// Per medium: connection_choice.h's third rule applies (every point and spot light sits in
+  /// a clear medium, and this one is thinner than kThinDepth across its shapes' bounding box).
+  std::vector<char> thin_media_;
   std::vector<double> point_pmf_;  ///< their pick probabilities, proportional to power
 };
 
