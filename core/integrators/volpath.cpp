@@ -14,6 +14,41 @@
 
 namespace femto {
 
+namespace {
+
+// connection_choice.h, third rule, per medium: every point and spot light sits in a medium that
+// does not scatter, and the medium is thinner than kThinDepth across the bounding box of the
+// shapes that bound it (the global medium, unbounded, never is).
+std::vector<char> thin_media_lit_from_outside(const Scene& scene, const std::vector<int>& lights) {
+  const std::vector<Medium>& media = scene.media();
+  std::vector<char> thin(media.size(), 0);
+  if (lights.empty()) return thin;
+  for (int i : lights)
+    if (media[static_cast<size_t>(scene.medium_at(scene.lights().light(i).position))].interacts())
+      return thin;
+  std::vector<Vec3> lo(media.size(), Vec3(kInf)), hi(media.size(), Vec3(-kInf));
+  const std::vector<ShapeDesc>& shapes = scene.desc().shapes;
+  for (size_t i = 0; i < shapes.size(); ++i) {
+    if (!bounds_a_medium(shapes[i])) continue;
+    const size_t m = static_cast<size_t>(scene.inside_medium(static_cast<int>(i)));
+    Vec3 a, b;
+    shape_bounds(shapes[i], a, b);
+    lo[m] = vmin(lo[m], a), hi[m] = vmax(hi[m], b);
+  }
+  for (size_t m = 0; m < media.size(); ++m) {
+    const Medium& med = media[m];
+    if (static_cast<int>(m) == scene.global_medium() || !med.interacts() || !(lo[m].x <= hi[m].x))
+      continue;
+    const double width = std::min({hi[m].x - lo[m].x, hi[m].y - lo[m].y, hi[m].z - lo[m].z});
+    const double sigma_t =
+        med.type == Medium::Type::Grid ? med.grid->mean_sigma_t() : med.homogeneous.sigma_t();
+    thin[m] = sigma_t * width < kThinDepth;
+  }
+  return thin;
+}
+
+}  // namespace
+
 VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& filter,
                                      int max_depth, const RouletteDesc& roulette)
     : scene_(scene),
@@ -34,33 +69,7 @@ VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& f
       total += lights.pmf(i);
     }
   for (double& p : point_pmf_) p /= total;
-  // connection_choice.h, third rule: no light inside a medium that scatters, and the media
-  // thinner than kThinDepth across the bounding box of their shapes (the global medium is not).
-  const std::vector<Medium>& media = scene.media();
-  bool outside = !point_lights_.empty();
-  for (int i : point_lights_)
-    outside = outside &&
-              !media[static_cast<size_t>(scene.medium_at(lights.light(i).position))].interacts();
-  thin_media_.assign(media.size(), 0);
-  if (!outside) return;
-  std::vector<Vec3> lo(media.size(), Vec3(kInf)), hi(media.size(), Vec3(-kInf));
-  const std::vector<ShapeDesc>& shapes = scene.desc().shapes;
-  for (size_t i = 0; i < shapes.size(); ++i) {
-    if (!bounds_a_medium(shapes[i])) continue;
-    const size_t m = static_cast<size_t>(scene.inside_medium(static_cast<int>(i)));
-    Vec3 a, b;
-    shape_bounds(shapes[i], a, b);
-    lo[m] = vmin(lo[m], a), hi[m] = vmax(hi[m], b);
-  }
-  for (size_t m = 0; m < media.size(); ++m) {
-    const Medium& med = media[m];
-    if (static_cast<int>(m) == scene.global_medium() || !med.interacts() || !(lo[m].x <= hi[m].x))
-      continue;
-    const double width = std::min({hi[m].x - lo[m].x, hi[m].y - lo[m].y, hi[m].z - lo[m].z});
-    const double sigma_t =
-        med.type == Medium::Type::Grid ? med.grid->mean_sigma_t() : med.homogeneous.sigma_t();
-    thin_media_[m] = sigma_t * width < kThinDepth;
-  }
+  thin_media_ = thin_media_lit_from_outside(scene, point_lights_);
 }
 
 void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,

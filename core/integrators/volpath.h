@@ -161,8 +161,7 @@ class VolPathIntegrator {
   bool unwarp_;
   double t_cut_;
   std::vector<int> point_lights_;  ///< point and spot lights: targets of angular sampling
-  /// Per medium: connection_choice.h's third rule applies (every point and spot light sits in
-  /// a clear medium, and this one is thinner than kThinDepth across its shapes' bounding box).
+  /// Per medium: connection_choice.h's third rule applies (thin_media_lit_from_outside).
   std::vector<char> thin_media_;
   std::vector<double> point_pmf_;  ///< their pick probabilities, proportional to power
 };
