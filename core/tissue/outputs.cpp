@@ -39,12 +39,20 @@ nlohmann::json summary_json(const Setup& s, const Result& r) {
                {"jackknife_se_ps", num(st.se)},
                {"ci95_ps", {num(st.ci_lo), num(st.ci_hi)}}};
     };
-    J pulse = ps.defined ? J{{"mean_time", stat(ps.mean)},
-                             {"rms_width", stat(ps.rms)},
-                             {"peak_time", stat(ps.peak)},
-                             {"peak_noise_limited", ps.peak_noise_limited},
-                             {"width_noise_limited", ps.width_noise_limited}}
-                         : J(nullptr);
+    J pulse =
+        ps.defined
+            ? J{{"mean_time", stat(ps.mean)},
+                {"rms_width", stat(ps.rms)},
+                {"peak_time", stat(ps.peak)},
+                {"peak_noise_limited", ps.peak_noise_limited},
+                {"width_noise_limited", ps.width_noise_limited},
+                {"gaussian_distance",
+                 {{"value", num(ps.gaussian_distance.value)},
+                  {"jackknife_se", num(ps.gaussian_distance.se)},
+                  {"ci95", {num(ps.gaussian_distance.ci_lo), num(ps.gaussian_distance.ci_hi)}},
+                  {"noise_floor", num(ps.gaussian_noise)},
+                  {"noise_limited", ps.gaussian_noise_limited}}}}
+            : J(nullptr);
     dets.push_back({{"index", d},
                     {"position_mm",
                      {s.detectors[d].center.x, s.detectors[d].center.y, s.detectors[d].center.z}},
