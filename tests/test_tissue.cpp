@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -437,6 +438,38 @@ TEST_CASE("femto render runs a tissue scene and writes the documented outputs", 
   CHECK(nv.dim == std::array<int, 4>{60, 60, 60, 50});
   CHECK(nv.data[((7ul * 60 + 30) * 60 + 30) * 60 + 30] ==
         Approx(fl[((30ul * 60 + 30) * 60 + 30) * 50 + 7]));
+}
+
+// Catches a run whose memory is not stated before it starts, or stated as something other than
+// the estimate it is checked against (--max-memory) and records: the line on stderr names the
+// fluence volume per thread and the total, and the total is render.json's estimate.
+TEST_CASE("femto render states a tissue run's memory before it starts", "[tissue][cli]") {
+  femto::test::TempDir tmp("femto_tissue_memory");
+  const std::string scene = (fs::path(FEMTO_SOURCE_DIR) / "data/scenes/cube60.json").string();
+  const auto run = femto::test::run_femto(
+      {"render", scene, "--out", "out", "--photons", "500", "--threads", "2"}, tmp.dir);
+  INFO(run.err);
+  REQUIRE(run.code == 0);
+  const nlohmann::json rec =
+      nlohmann::json::parse(femto::test::read_file(tmp.dir / "out/render.json"));
+  const uint64_t need = rec["memory_bytes_estimate"].get<uint64_t>();
+  const size_t line = run.err.find("memory: fluence volume ");
+  REQUIRE(line != std::string::npos);
+  CHECK(run.err.find("x 2 threads", line) != std::string::npos);
+  // "total 227.5 MiB": the estimate to the printed digit, before the run's end line.
+  const size_t at = run.err.find("total ", line);
+  REQUIRE(at != std::string::npos);
+  CHECK(at < run.err.find("photons in", line));
+  double value = 0;
+  char unit[8] = {};
+  REQUIRE(std::sscanf(run.err.c_str() + at, "total %lf %7s", &value, unit) == 2);
+  const double scale = std::string(unit) == "GiB"   ? 1073741824.0
+                       : std::string(unit) == "MiB" ? 1048576.0
+                       : std::string(unit) == "KiB" ? 1024.0
+                                                    : 1.0;
+  CHECK(std::abs(value * scale - static_cast<double>(need)) <= 0.05 * scale);
+  // The fluence sums alone: 64-bit cells of 4^3 bricks over 60^3 voxels x 50 gates, 2 threads.
+  CHECK(need > 2 * 60ull * 60 * 60 * 50 * 8);
 }
 
 // Catches wrong pulse moments or intervals: a sampled Gaussian pulse histogram has the pulse's
