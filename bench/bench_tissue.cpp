@@ -1,14 +1,17 @@
 // femto-bench-tissue: speed of the tissue-optics Monte Carlo on the classic 60 mm cube
 // (data/scenes/cube60.json: mu_a 0.005/mm, mu_s 1/mm, g 0.01, n 1.37, 50 gates of 0.1 ns,
 // 60^3 fluence voxels, four detectors), with 1 and 2 threads, and a check that both give the
-// same bits. Usage: femto-bench-tissue [SCENE.json] [photons] (default data/scenes/cube60.json,
-// 1e6)
+// same bits. Usage: femto-bench-tissue [SCENE.json] [photons] [--fluence-only] (default
+// data/scenes/cube60.json, 1e6). --fluence-only drops the scene's face images and detectors:
+// the classic tally (fluence volume and absorbed fraction) that the other tissue codes compute
+// in bench/reference/run.sh.
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "bench/bench_util.h"
 #include "core/scene_loader.h"
@@ -19,13 +22,28 @@ using namespace femto;
 using femto::bench::cpu_model;
 
 int main(int argc, char** argv) {
-  const std::string path = argc > 1 ? argv[1] : "data/scenes/cube60.json";
-  const uint64_t photons = argc > 2 ? static_cast<uint64_t>(std::atof(argv[2])) : 1000000;
+  bool fluence_only = false;
+  std::vector<std::string> args;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--fluence-only")
+      fluence_only = true;
+    else
+      args.push_back(a);
+  }
+  const std::string path = args.size() > 0 ? args[0] : "data/scenes/cube60.json";
+  const uint64_t photons =
+      args.size() > 1 ? static_cast<uint64_t>(std::atof(args[1].c_str())) : 1000000;
   tissue::Setup s = tissue::load_tissue_scene(read_scene_text(path), path,
                                               std::filesystem::path(path).parent_path().string());
   s.photons = photons;
-  std::printf("femto-bench-tissue: %s, %llu photons; CPU: %s\n", path.c_str(),
-              static_cast<unsigned long long>(photons), cpu_model().c_str());
+  if (fluence_only) {
+    s.faces = false;
+    s.detectors.clear();
+  }
+  std::printf("femto-bench-tissue: %s%s, %llu photons; CPU: %s\n", path.c_str(),
+              fluence_only ? " (fluence only)" : "", static_cast<unsigned long long>(photons),
+              cpu_model().c_str());
   // CPU time as well as wall time: on a shared machine, photons per CPU-ms per thread is the
   // figure that does not depend on what else runs.
   std::printf(

@@ -2,7 +2,9 @@
 # femto's cube60 benchmark against the established tissue Monte Carlo codes on the same machine,
 # interleaved round by round (docs/PERFORMANCE.md, "Against MMC and MCX-CL on the same host").
 # The other codes are not part of femto: build them yourself (commands below) and pass their
-# binaries. Each round runs femto-bench-tissue (1 and 2 threads), then MMC and MCX-CL with 1 and
+# binaries. Each round runs femto-bench-tissue (1 and 2 threads) on the scene as shipped (with
+# its face images and four detectors) and with --fluence-only (the classic tally the other codes
+# compute here: the fluence volume and the absorbed fraction), then MMC and MCX-CL with 1 and
 # 2 threads, all on 1e6 photons, and prints photons/ms as each program reports it (MMC and
 # MCX-CL: their "speed" line, which leaves out setup, kernel compilation and output).
 #
@@ -24,11 +26,14 @@ strip() { sed 's/\x1b\[[0-9;]*m//g'; }
 for r in $(seq "$rounds"); do
   # femto: the bench's 1- and 2-thread rows (photons/ms wall clock, the absorbed fraction).
   if [ "$femto" != - ]; then
-    "$femto" "$root/data/scenes/cube60.json" 1e6 > "$work/femto" 2>&1
-    # Also its tracing-only rate (no allocation, reductions or results), the nearer match to
-    # the other codes' "speed", which leaves out their setup and output.
-    awk -v r="$r" 'NF == 9 && $1 ~ /^[12]$/ {t = $5; sub(/\(/, "", t)
-      printf "round %s femto  threads %s  %7.1f photons/ms  absorbed %s  (tracing only %s)\n", r, $1, $2, $9, t}' "$work/femto"
+    for tally in all fluence; do
+      "$femto" "$root/data/scenes/cube60.json" 1e6 $([ $tally = fluence ] && echo --fluence-only) \
+        > "$work/femto" 2>&1
+      # Also its tracing-only rate (no allocation, reductions or results), the nearer match to
+      # the other codes' "speed", which leaves out their setup and output.
+      awk -v r="$r" -v k="$tally" 'NF == 9 && $1 ~ /^[12]$/ {t = $5; sub(/\(/, "", t)
+        printf "round %s femto  threads %s  %7.1f photons/ms  absorbed %s  (tracing only %s; tallies: %s)\n", r, $1, $2, $9, t, k}' "$work/femto"
+    done
   fi
   for t in 1 2; do
     if [ "$mmc" != - ]; then
