@@ -46,10 +46,19 @@ struct WalkOptics {
   double v = kSpeedOfLight;  ///< c / n, mm/ps
   // Reciprocals (+inf for 0): a step multiplies instead of dividing.
   double inv_mu_s = kInf, inv_mu_t = kInf, inv_v = 1 / kSpeedOfLight;
+  HgCosSampler hg;  ///< the scattering cosine's constants for g
   static WalkOptics of(double mu_a, double mu_s, double g, double n) {
     const double mu_t = mu_a + mu_s, v = kSpeedOfLight / n;
-    return {mu_a, mu_s, mu_t, g, n, v, mu_s > 0 ? 1 / mu_s : kInf, mu_t > 0 ? 1 / mu_t : kInf,
-            1 / v};
+    return {mu_a,
+            mu_s,
+            mu_t,
+            g,
+            n,
+            v,
+            mu_s > 0 ? 1 / mu_s : kInf,
+            mu_t > 0 ? 1 / mu_t : kInf,
+            1 / v,
+            HgCosSampler::of(g)};
   }
   static WalkOptics of(const TissueOptics& o) { return of(o.mu_a, o.mu_s, o.g, o.n); }
 };
@@ -352,7 +361,7 @@ StepEvent walk_step(const Space& space, const WalkSettings& ws, Photon& p, Rng& 
   // azimuth's first, as GCC evaluated them.
   const double u_phi = rng.uniform32();
   const double u_cos = rng.uniform32();
-  p.d = hg_sample_direction(p.d, o.g, u_cos, u_phi);
+  p.d = hg_sample_direction(p.d, o.hg, u_cos, u_phi);
   ++p.scatterings;
   return StepEvent::Scattered;
 }
