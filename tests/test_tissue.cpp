@@ -373,6 +373,14 @@ TEST_CASE("femto render refuses bad tissue scenes with exit 2 and writes nothing
        "cube.json: /tissue/labels: label 7 occurs in the volume but has no optical properties"},
       {R"("type": "pencil")", R"("type": "laser")",
        "cube.json: /tissue/source/type: must be one of"},
+      {R"("type": "pencil")", R"("type": "sphere", "radius": 2)",
+       "cube.json: /tissue/source/direction: a sphere source has no direction"},
+      {R"("type": "pencil", "position": [30, 30, 0], "direction": [0, 0, 1])",
+       R"("type": "quad", "position": [0, 0, -1], "edge1": [60, 0, 0], "edge2": [-6, 0, 0])",
+       "cube.json: /tissue/source/edge2: parallel to edge1: the quad has no area (got [-6,0,0])"},
+      {R"("type": "pencil", "position": [30, 30, 0], "direction": [0, 0, 1])",
+       R"("type": "quad", "position": [0, 0, -1], "edge2": [0, 60, 0])",
+       "cube.json: /tissue/source/edge1: required for a quad source"},
   };
   for (const Case& c : cases) {
     std::string text = good;

@@ -9,12 +9,14 @@
 #include "core/bsdf/fresnel.h"
 #include "core/io/nifti.h"
 #include "core/io/npy.h"
+#include "core/tissue/launch.h"
 #include "core/tissue/pulse.h"
 #include "core/tissue/scene.h"
 #include "core/tissue/simulate.h"
 #include "core/transport/tissue_walk.h"
 #include "media/label_grid_vdb.h"
 #include "run_femto.h"
+#include "samplers/stats.h"
 #include "temp_dir.h"
 #include "tissue_setups.h"
 
@@ -111,4 +113,65 @@ TEST_CASE("a spot source emits in its cone with unit mean weight", "[tissue]") {
   INFO("mean launch weight " << f.balance.launched / N);
   CHECK(std::abs(f.balance.launched / N - 1) <= 4 * std::sqrt(w_max / N));
   CHECK(std::abs(f.balance.residual()) <= 1e-12 * f.balance.launched);
+}
+
+// Catches emissive-shape sources that do not emit as the camera scenes' emissive shapes do
+// (docs/tissue.md, "Sources"): points uniform over the area (a sphere's height uniform in
+// [-R, R], a quad's coordinates along its edges uniform in [0, 1]^2), directions cosine-weighted
+// about the outward normal (cos^2 uniform in [0, 1]), every weight 1; chi-square tests on 20
+// bins each, with the walk's launch inside a clear box that holds the shape.
+TEST_CASE("sphere and quad sources emit from their surface as Lambertian emitters", "[tissue]") {
+  for (const Source::Type type : {Source::Type::Sphere, Source::Type::Quad}) {
+    Setup s = tissue_box(40, 40, 40, 1.0, TissueOptics{0, 0, 0, 1.0});
+    s.source.type = type;
+    s.source.position = type == Source::Type::Sphere ? Vec3{20, 21, 19} : Vec3{5, 6, 7};
+    s.source.radius = 6;
+    s.source.edge1 = {20, 5, 0};
+    s.source.edge2 = {0, 0, 25};
+    const Vec3 quad_n = normalize(cross(s.source.edge1, s.source.edge2));
+    const LabelSpace space(s.volume, false);
+    const Emitter emitter(s.source);
+    const int N = 40000, bins = 20;
+    std::vector<double> where(bins, 0), where2(bins, 0), cos2(bins, 0);
+    double worst_off = 0, worst_w = 0;
+    for (int i = 0; i < N; ++i) {
+      Rng rng = Rng::for_sample(7, static_cast<uint64_t>(i), 0);
+      Photon p;
+      double specular = 0;
+      REQUIRE(launch(s, space, emitter, rng, p, specular));  // the shape is inside the box
+      worst_w = std::max(worst_w, std::abs(p.w - 1));
+      Vec3 n;
+      if (type == Source::Type::Sphere) {
+        const Vec3 r = p.x - s.source.position;
+        worst_off = std::max(worst_off, std::abs(length(r) - 6));
+        n = normalize(r);
+        where[static_cast<size_t>(std::min(bins - 1, static_cast<int>((n.z + 1) / 2 * bins)))] += 1;
+      } else {
+        const Vec3 r = p.x - s.source.position;
+        worst_off = std::max(worst_off, std::abs(dot(r, quad_n)));
+        const double a = dot(r, s.source.edge1) / length_squared(s.source.edge1),
+                     b = dot(r, s.source.edge2) / length_squared(s.source.edge2);
+        where[static_cast<size_t>(std::clamp(static_cast<int>(a * bins), 0, bins - 1))] += 1;
+        where2[static_cast<size_t>(std::clamp(static_cast<int>(b * bins), 0, bins - 1))] += 1;
+        n = quad_n;
+      }
+      const double c = dot(p.d, n);
+      REQUIRE(c >= 0);
+      cos2[static_cast<size_t>(std::min(bins - 1, static_cast<int>(c * c * bins)))] += 1;
+    }
+    CHECK(worst_off < 1e-9);
+    CHECK(worst_w < 1e-12);
+    const std::vector<double> flat(bins, static_cast<double>(N) / bins);
+    for (const auto* h : {&where, &cos2}) {
+      const stats::Chi2Result t = stats::chi2_test(*h, flat);
+      INFO((type == Source::Type::Sphere ? "sphere" : "quad")
+           << (h == &where ? " position" : " cos^2") << ": chi2 " << t.chi2 << ", p " << t.p_value);
+      CHECK(t.p_value >= 1e-3);
+    }
+    if (type == Source::Type::Quad) {
+      const stats::Chi2Result t = stats::chi2_test(where2, flat);
+      INFO("quad, along edge2: chi2 " << t.chi2 << ", p " << t.p_value);
+      CHECK(t.p_value >= 1e-3);
+    }
+  }
 }

@@ -20,6 +20,29 @@ double standard_normal(Rng& rng) {
 }  // namespace
 
 Emitter::Emitter(const Source& src) {
+  if (src.type == Source::Type::Sphere || src.type == Source::Type::Quad) {
+    // The camera scenes' emissive shapes: uniform over the area, cosine-weighted about the
+    // normal (a Lambertian emitter), from the light code's sample_emission.
+    ShapeDesc sh;
+    sh.emissive = true;
+    sh.emission = RGB(1.0);
+    if (src.type == Source::Type::Sphere) {
+      sh.type = ShapeDesc::Type::Sphere;
+      sh.center = src.position;
+      sh.radius = src.radius;
+    } else {
+      sh.type = ShapeDesc::Type::Quad;
+      const Vec3 o = src.position;
+      sh.vertices = {o, o + src.edge1, o + src.edge1 + src.edge2, o + src.edge2};
+      sh.triangles = {{0, 1, 2}, {0, 2, 3}};  // normal edge1 x edge2, as the camera scenes' quad
+    }
+    scene.shapes = {sh};
+    lights = std::make_unique<LightSet>(scene);
+    LightEmission e;  // beta = Le pi A for every ray: weight 1 after this
+    if (lights->sample_emission(0, 0.5, 0.5, 0.5, 0.5, e) && e.beta.r > 0)
+      inv_mean_beta = 1 / e.beta.r;
+    return;
+  }
   if (src.type != Source::Type::Spot) return;
   LightDesc d;
   d.type = LightDesc::Type::Spot;
@@ -74,6 +97,14 @@ bool launch(const Setup& s, const Space& space, const Emitter& emitter, Rng& rng
       p.w = 0;  // outside the falloff: no energy (never for u1 < 1)
       return false;
     }
+    p.d = e.ray.d;
+    p.w = e.beta.r * emitter.inv_mean_beta;
+  } else if (src.type == Source::Type::Sphere || src.type == Source::Type::Quad) {
+    // Two draws for the point, two for the direction, in this order.
+    const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
+    LightEmission e;
+    if (!emitter.lights->sample_emission(0, u1, u2, u3, u4, e)) return false;
+    p.x = e.ray.o;
     p.d = e.ray.d;
     p.w = e.beta.r * emitter.inv_mean_beta;
   }

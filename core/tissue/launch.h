@@ -12,8 +12,8 @@
 
 namespace femto::tissue {
 
-/// Sources emitted by the camera scenes' light code (spot): the light and the normalisation that
-/// makes the mean launch weight 1.
+/// Sources emitted by the camera scenes' light code (spot, emissive sphere and quad): the light
+/// and the normalisation that makes the mean launch weight 1.
 struct Emitter {
   SceneDesc scene;
   std::unique_ptr<LightSet> lights;

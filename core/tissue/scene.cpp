@@ -322,19 +322,25 @@ void read_medium(const Reader& rd, const Json& j, const std::string& P, double o
 void read_source(const Reader& rd, const Json& j, const std::string& P, Source& src) {
   rd.object(j, P,
             {"type", "position", "direction", "waist", "radius", "cone_angle", "falloff_start",
-             "pulse", "specular"});
+             "edge1", "edge2", "pulse", "specular"});
   if (!j.contains("type")) rd.fail(P + "/type", "required");
   const std::string type =
-      rd.string(j["type"], P + "/type", {"pencil", "gaussian", "disk", "isotropic", "spot"});
+      rd.string(j["type"], P + "/type",
+                {"pencil", "gaussian", "disk", "isotropic", "spot", "sphere", "quad"});
   src.type = type == "pencil"     ? Source::Type::Pencil
              : type == "gaussian" ? Source::Type::Gaussian
              : type == "disk"     ? Source::Type::Disk
              : type == "spot"     ? Source::Type::Spot
+             : type == "sphere"   ? Source::Type::Sphere
+             : type == "quad"     ? Source::Type::Quad
                                   : Source::Type::Isotropic;
   if (!j.contains("position")) rd.fail(P + "/position", "required");
   src.position = rd.vec3(j["position"], P + "/position");
-  if (src.type == Source::Type::Isotropic) {
-    if (j.contains("direction")) rd.fail(P + "/direction", "an isotropic source has no direction");
+  const bool surface = src.type == Source::Type::Sphere || src.type == Source::Type::Quad;
+  if (src.type == Source::Type::Isotropic || surface) {
+    if (j.contains("direction"))
+      rd.fail(P + "/direction", "a" + std::string(surface ? " " : "n ") + type +
+                                    " source has no direction (it emits from its surface)");
   } else {
     if (!j.contains("direction")) rd.fail(P + "/direction", "required for a " + type + " source");
     src.direction = normalize(rd.vec3(j["direction"], P + "/direction", true));
@@ -346,11 +352,22 @@ void read_source(const Reader& rd, const Json& j, const std::string& P, Source& 
   } else if (j.contains("waist")) {
     rd.fail(P + "/waist", "applies to gaussian sources only");
   }
-  if (src.type == Source::Type::Disk) {
-    if (!j.contains("radius")) rd.fail(P + "/radius", "required for a disk source (mm)");
+  if (src.type == Source::Type::Disk || src.type == Source::Type::Sphere) {
+    if (!j.contains("radius")) rd.fail(P + "/radius", "required for a " + type + " source (mm)");
     src.radius = rd.number(j["radius"], P + "/radius", 0, 1e6, true);
   } else if (j.contains("radius")) {
-    rd.fail(P + "/radius", "applies to disk sources only");
+    rd.fail(P + "/radius", "applies to disk and sphere sources only");
+  }
+  if (src.type == Source::Type::Quad) {  // the keys of the camera scenes' quad
+    for (const char* k : {"edge1", "edge2"})
+      if (!j.contains(k)) rd.fail(P + "/" + k, "required for a quad source (mm)");
+    src.edge1 = rd.vec3(j["edge1"], P + "/edge1", true);
+    src.edge2 = rd.vec3(j["edge2"], P + "/edge2", true);
+    if (!(length(cross(src.edge1, src.edge2)) > 1e-12 * length(src.edge1) * length(src.edge2)))
+      rd.fail(P + "/edge2", "parallel to edge1: the quad has no area", j["edge2"]);
+  } else {
+    for (const char* k : {"edge1", "edge2"})
+      if (j.contains(k)) rd.fail(P + "/" + k, "applies to quad sources only");
   }
   if (src.type == Source::Type::Spot) {  // the keys and defaults of the camera scenes' spot light
     if (!j.contains("cone_angle"))

@@ -20,12 +20,13 @@ namespace femto::tissue {
 /// (in the outside index) to the first tissue voxel. Spot: the camera scenes' spot light (emitted
 /// through core/lights.h), directions uniform in its cone weighted by its smooth falloff.
 struct Source {
-  enum class Type { Pencil, Gaussian, Disk, Isotropic, Spot };
+  enum class Type { Pencil, Gaussian, Disk, Isotropic, Spot, Sphere, Quad };
   Type type = Type::Pencil;
-  Vec3 position{0, 0, 0};
-  Vec3 direction{0, 0, 1};        ///< unit; unused by isotropic
+  Vec3 position{0, 0, 0};         ///< sphere: its centre; quad: its corner
+  Vec3 direction{0, 0, 1};        ///< unit; unused by isotropic, sphere and quad
   double waist = 0;               ///< gaussian: 1/e^2 intensity radius, mm
-  double radius = 0;              ///< disk: radius, mm
+  double radius = 0;              ///< disk, sphere: radius, mm
+  Vec3 edge1{0, 0, 0}, edge2{0, 0, 0};  ///< quad: its edges; it emits along edge1 x edge2
   double cone_angle_deg = 30;     ///< spot: half-angle of the cone
   double falloff_start_deg = 24;  ///< spot: half-angle where the smooth falloff starts
   double fwhm_ps = 0;             ///< Gaussian pulse FWHM; 0 = delta pulse
