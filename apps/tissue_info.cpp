@@ -24,6 +24,10 @@ const char* source_name(tissue::Source::Type t) {
          : t == T::Gaussian ? "gaussian"
          : t == T::Disk     ? "disk"
          : t == T::Spot     ? "spot"
+         : t == T::Sphere   ? "sphere"
+         : t == T::Quad     ? "quad"
+         : t == T::Box      ? "box"
+         : t == T::Mesh     ? "mesh"
                             : "isotropic";
 }
 }  // namespace
@@ -63,8 +67,18 @@ void print_tissue_info(const std::string& text, const std::string& path) {
               s.fresnel ? "fresnel" : "matched",
               s.absorption == Absorption::Weighted ? "weighted" : "analog");
   const tissue::Source& src = s.source;
-  std::printf("source: %s at %s", source_name(src.type), vec(src.position).c_str());
-  if (src.type != tissue::Source::Type::Isotropic)
+  using ST = tissue::Source::Type;
+  std::printf("source: %s", source_name(src.type));
+  if (src.type == ST::Box)
+    std::printf(" from %s to %s mm", vec(src.box_min).c_str(), vec(src.box_max).c_str());
+  else if (src.type == ST::Mesh)
+    std::printf(" of %zu triangles", src.mesh_triangles.size());
+  else
+    std::printf(" at %s", vec(src.position).c_str());
+  if (src.type == ST::Sphere) std::printf(", radius %s mm", g6(src.radius).c_str());
+  if (src.type == ST::Quad)
+    std::printf(", edges %s and %s mm", vec(src.edge1).c_str(), vec(src.edge2).c_str());
+  if (src.type != ST::Isotropic && !tissue::is_surface(src.type))
     std::printf(", direction %s", vec(src.direction).c_str());
   if (src.fwhm_ps > 0)
     std::printf(", Gaussian pulse of FWHM %s ps at %s ps\n", g6(src.fwhm_ps).c_str(),

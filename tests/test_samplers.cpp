@@ -146,8 +146,9 @@ TEST_CASE("the walk's HG direction sampler matches hg_eval (chi-square)", "[samp
 
 // Catches a walk whose direction drifts off the unit sphere: hg_sample_direction does not
 // renormalise (that step sat on the walk's critical path), which is safe only because the frame
-// of a direction carries its length error into the new one scaled by cos theta^2 < 1, so errors
-// stay at a few ulp instead of growing. 10^6 chained scatterings per g, lengths in long double.
+// of a direction of squared length 1 + delta gives a new one of 1 + k delta (plus rounding), with
+// k of mean at most 1 over the azimuth, so the error wanders at tens of ulp instead of growing.
+// 10^6 chained scatterings per g, lengths in long double.
 TEST_CASE("chained HG scatterings keep unit directions without renormalising", "[samplers][hg]") {
   for (const double g : {-0.9, 0.01, 0.9, 0.99, 0.999}) {
     const femto::HgCosSampler hg = femto::HgCosSampler::of(g);

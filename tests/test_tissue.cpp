@@ -381,6 +381,17 @@ TEST_CASE("femto render refuses bad tissue scenes with exit 2 and writes nothing
       {R"("type": "pencil", "position": [30, 30, 0], "direction": [0, 0, 1])",
        R"("type": "quad", "position": [0, 0, -1], "edge2": [0, 60, 0])",
        "cube.json: /tissue/source/edge1: required for a quad source"},
+      {R"("type": "pencil", "position": [30, 30, 0], "direction": [0, 0, 1])",
+       R"("type": "box", "min": [0, 0, -2], "max": [60, 60, -3])",
+       "cube.json: /tissue/source/max: must exceed 'min' on every axis (got [60,60,-3])"},
+      {R"("type": "pencil", "position": [30, 30, 0], "direction": [0, 0, 1])",
+       R"("type": "mesh", "file": "missing.obj")",
+       "cube.json: /tissue/source/file: mesh file not found"},
+      {R"("type": "pencil", "position": [30, 30, 0], "direction": [0, 0, 1])",
+       R"("type": "mesh", "position": [0, 0, 0], "file": "missing.obj")",
+       "cube.json: /tissue/source/position: a mesh source has no position"},
+      {R"("type": "pencil")", R"("type": "isotropic")",
+       "cube.json: /tissue/source/direction: an isotropic source has no direction\n"},
   };
   for (const Case& c : cases) {
     std::string text = good;
@@ -487,6 +498,7 @@ TEST_CASE("femto render states a tissue run's memory before it starts", "[tissue
   // "total 227.5 MiB": the estimate to the printed digit, before the run's end line.
   const size_t at = run.err.find("total ", line);
   REQUIRE(at != std::string::npos);
+  REQUIRE(run.err.find("photons in", line) != std::string::npos);
   CHECK(at < run.err.find("photons in", line));
   double value = 0;
   char unit[8] = {};

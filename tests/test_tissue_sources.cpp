@@ -9,6 +9,7 @@
 #include "core/bsdf/fresnel.h"
 #include "core/io/nifti.h"
 #include "core/io/npy.h"
+#include "core/obj_loader.h"
 #include "core/tissue/launch.h"
 #include "core/tissue/pulse.h"
 #include "core/tissue/scene.h"
@@ -173,5 +174,82 @@ TEST_CASE("sphere and quad sources emit from their surface as Lambertian emitter
       INFO("quad, along edge2: chi2 " << t.chi2 << ", p " << t.p_value);
       CHECK(t.p_value >= 1e-3);
     }
+  }
+}
+
+// Catches box and mesh sources that do not emit as the camera scenes' emissive boxes and meshes:
+// every point on the surface, the faces hit in proportion to their areas (chi-square over the
+// box's 6 faces and the icosahedron's 20), directions cosine-weighted about the outward normal
+// of the face they leave (cos^2 uniform, chi-square), weights 1. data/meshes/icosahedron.obj,
+// a convex unit icosahedron: a point's face is the one whose plane it lies on.
+TEST_CASE("box and mesh sources emit from their faces as Lambertian emitters", "[tissue]") {
+  for (const Source::Type type : {Source::Type::Box, Source::Type::Mesh}) {
+    Setup s = tissue_box(40, 40, 40, 1.0, TissueOptics{0, 0, 0, 1.0});
+    s.volume.origin = {-20, -20, -20};
+    s.source.type = type;
+    s.source.box_min = {-3, -1, 2};
+    s.source.box_max = {5, 1, 6};
+    load_obj((std::filesystem::path(FEMTO_SOURCE_DIR) / "data/meshes/icosahedron.obj").string(),
+             s.source.mesh_vertices, s.source.mesh_triangles);
+    // Faces as (unit outward normal, a point on it, area).
+    std::vector<Vec3> normal, point;
+    std::vector<double> area;
+    if (type == Source::Type::Box) {
+      const Vec3 lo = s.source.box_min, hi = s.source.box_max, e = hi - lo;
+      for (int a = 0; a < 3; ++a)
+        for (int side = 0; side < 2; ++side) {
+          Vec3 n{0, 0, 0};
+          n[a] = side ? 1 : -1;
+          normal.push_back(n);
+          point.push_back(side ? hi : lo);
+          area.push_back(e[(a + 1) % 3] * e[(a + 2) % 3]);
+        }
+    } else {
+      for (const auto& t : s.source.mesh_triangles) {
+        const Vec3 &a = s.source.mesh_vertices[t[0]], &b = s.source.mesh_vertices[t[1]],
+                   &c = s.source.mesh_vertices[t[2]];
+        const Vec3 n = cross(b - a, c - a);
+        normal.push_back(normalize(n));
+        point.push_back(a);
+        area.push_back(0.5 * length(n));
+      }
+    }
+    double total_area = 0;
+    for (double x : area) total_area += x;
+    const LabelSpace space(s.volume, false);
+    const Emitter emitter(s.source);
+    const int N = 40000, bins = 20;
+    std::vector<double> faces(normal.size(), 0), cos2(bins, 0);
+    double worst_off = 0, worst_w = 0;
+    for (int i = 0; i < N; ++i) {
+      Rng rng = Rng::for_sample(9, static_cast<uint64_t>(i), 0);
+      Photon p;
+      double specular = 0;
+      REQUIRE(launch(s, space, emitter, rng, p, specular));
+      worst_w = std::max(worst_w, std::abs(p.w - 1));
+      // The face whose plane the point lies on: for a convex shape, the largest signed distance.
+      size_t f = 0;
+      double best = -1e300;
+      for (size_t k = 0; k < normal.size(); ++k) {
+        const double h = dot(p.x - point[k], normal[k]);
+        if (h > best) best = h, f = k;
+      }
+      worst_off = std::max(worst_off, std::abs(best));
+      faces[f] += 1;
+      const double c = dot(p.d, normal[f]);
+      REQUIRE(c >= 0);
+      cos2[static_cast<size_t>(std::min(bins - 1, static_cast<int>(c * c * bins)))] += 1;
+    }
+    CHECK(worst_off < 1e-9);
+    CHECK(worst_w < 1e-12);
+    std::vector<double> expected;
+    for (double x : area) expected.push_back(N * x / total_area);
+    const stats::Chi2Result tf = stats::chi2_test(faces, expected);
+    const stats::Chi2Result tc = stats::chi2_test(cos2, std::vector<double>(bins, 1.0 * N / bins));
+    INFO((type == Source::Type::Box ? "box" : "mesh")
+         << ": faces chi2 " << tf.chi2 << ", p " << tf.p_value << "; cos^2 chi2 " << tc.chi2
+         << ", p " << tc.p_value);
+    CHECK(tf.p_value >= 1e-3);
+    CHECK(tc.p_value >= 1e-3);
   }
 }

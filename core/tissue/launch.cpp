@@ -6,6 +6,7 @@
 
 #include "core/bsdf/fresnel.h"
 #include "core/sampling.h"
+#include "core/scene_json/loader.h"  // make_box
 #include "core/sincos_2pi.h"
 #include "core/transport/voxel_space.h"
 #include "media/grid_medium.h"  // clamped_floor
@@ -20,7 +21,7 @@ double standard_normal(Rng& rng) {
 }  // namespace
 
 Emitter::Emitter(const Source& src) {
-  if (src.type == Source::Type::Sphere || src.type == Source::Type::Quad) {
+  if (is_surface(src.type)) {
     // The camera scenes' emissive shapes: uniform over the area, cosine-weighted about the
     // normal (a Lambertian emitter), from the light code's sample_emission.
     ShapeDesc sh;
@@ -30,11 +31,18 @@ Emitter::Emitter(const Source& src) {
       sh.type = ShapeDesc::Type::Sphere;
       sh.center = src.position;
       sh.radius = src.radius;
-    } else {
+    } else if (src.type == Source::Type::Quad) {
       sh.type = ShapeDesc::Type::Quad;
       const Vec3 o = src.position;
       sh.vertices = {o, o + src.edge1, o + src.edge1 + src.edge2, o + src.edge2};
       sh.triangles = {{0, 1, 2}, {0, 2, 3}};  // normal edge1 x edge2, as the camera scenes' quad
+    } else if (src.type == Source::Type::Box) {
+      sh.type = ShapeDesc::Type::Box;
+      scene_json::make_box(src.box_min, src.box_max, sh);  // faces point outwards
+    } else {
+      sh.type = ShapeDesc::Type::Mesh;
+      sh.vertices = src.mesh_vertices;
+      sh.triangles = src.mesh_triangles;
     }
     scene.shapes = {sh};
     lights = std::make_unique<LightSet>(scene);
@@ -99,7 +107,7 @@ bool launch(const Setup& s, const Space& space, const Emitter& emitter, Rng& rng
     }
     p.d = e.ray.d;
     p.w = e.beta.r * emitter.inv_mean_beta;
-  } else if (src.type == Source::Type::Sphere || src.type == Source::Type::Quad) {
+  } else if (is_surface(src.type)) {
     // Two draws for the point, two for the direction, in this order.
     const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
     LightEmission e;

@@ -20,6 +20,9 @@ struct Emitter {
   double inv_mean_beta = 1;
   double max_weight = 1;  ///< the largest launch weight
   explicit Emitter(const Source& src);
+  // `lights` points into `scene`: built in place, never copied or moved.
+  Emitter(const Emitter&) = delete;
+  Emitter& operator=(const Emitter&) = delete;
 };
 
 /// Launches photon p from the source (position, direction, time, weight) and moves it to the first

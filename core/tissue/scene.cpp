@@ -10,6 +10,8 @@
 #include "core/constants.h"
 #include "core/error.h"
 #include "core/io/nifti.h"
+#include "core/io/ply.h"
+#include "core/obj_loader.h"
 #include "media/label_grid_vdb.h"
 #include "media/volume_data.h"
 
@@ -319,28 +321,77 @@ void read_medium(const Reader& rd, const Json& j, const std::string& P, double o
               TissueOptics{mu_a_sum / cells, mu_s_sum / cells, g, d.eta}};
 }
 
+// The keys of box and mesh sources (the camera scenes' box and mesh shapes, without transforms).
+void read_surface_source(const Reader& rd, const Json& j, const std::string& P,
+                         const std::string& type, Source& src) {
+  const bool box = src.type == Source::Type::Box, mesh = src.type == Source::Type::Mesh;
+  for (const char* k : {"min", "max"}) {
+    if (box && !j.contains(k)) rd.fail(P + "/" + k, "required for a box source (mm)");
+    if (!box && j.contains(k)) rd.fail(P + "/" + k, "applies to box sources only");
+  }
+  if (box) {
+    src.box_min = rd.vec3(j["min"], P + "/min");
+    src.box_max = rd.vec3(j["max"], P + "/max");
+    const Vec3 lo = src.box_min, hi = src.box_max;
+    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+      rd.fail(P + "/max", "must exceed 'min' on every axis", j["max"]);
+  }
+  if (mesh != j.contains("file"))
+    rd.fail(P + "/file", mesh ? "required for a mesh source (an OBJ or PLY file, mm)"
+                              : "applies to mesh sources only");
+  if (!mesh) return;
+  const std::string path = rd.file(j["file"], P + "/file");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    rd.fail(P + "/file", "mesh file not found: " + clip(path, 200), j["file"]);
+  try {
+    if (std::filesystem::path(path).extension() == ".ply")
+      load_ply(path, src.mesh_vertices, src.mesh_triangles);
+    else
+      load_obj(path, src.mesh_vertices, src.mesh_triangles);
+  } catch (const InputError& e) {
+    rd.fail(P + "/file", e.what());
+  }
+  double area = 0;
+  for (const auto& t : src.mesh_triangles)
+    area += length(cross(src.mesh_vertices[t[1]] - src.mesh_vertices[t[0]],
+                         src.mesh_vertices[t[2]] - src.mesh_vertices[t[0]]));
+  if (!(area > 0)) rd.fail(P + "/file", "the " + type + " has no area", j["file"]);
+}
+
 void read_source(const Reader& rd, const Json& j, const std::string& P, Source& src) {
   rd.object(j, P,
             {"type", "position", "direction", "waist", "radius", "cone_angle", "falloff_start",
-             "edge1", "edge2", "pulse", "specular"});
+             "edge1", "edge2", "min", "max", "file", "pulse", "specular"});
   if (!j.contains("type")) rd.fail(P + "/type", "required");
-  const std::string type =
-      rd.string(j["type"], P + "/type",
-                {"pencil", "gaussian", "disk", "isotropic", "spot", "sphere", "quad"});
+  const std::string type = rd.string(
+      j["type"], P + "/type",
+      {"pencil", "gaussian", "disk", "isotropic", "spot", "sphere", "quad", "box", "mesh"});
   src.type = type == "pencil"     ? Source::Type::Pencil
              : type == "gaussian" ? Source::Type::Gaussian
              : type == "disk"     ? Source::Type::Disk
              : type == "spot"     ? Source::Type::Spot
              : type == "sphere"   ? Source::Type::Sphere
              : type == "quad"     ? Source::Type::Quad
+             : type == "box"      ? Source::Type::Box
+             : type == "mesh"     ? Source::Type::Mesh
                                   : Source::Type::Isotropic;
-  if (!j.contains("position")) rd.fail(P + "/position", "required");
-  src.position = rd.vec3(j["position"], P + "/position");
-  const bool surface = src.type == Source::Type::Sphere || src.type == Source::Type::Quad;
+  const bool placed = src.type != Source::Type::Box && src.type != Source::Type::Mesh;
+  if (placed) {
+    if (!j.contains("position")) rd.fail(P + "/position", "required");
+    src.position = rd.vec3(j["position"], P + "/position");
+  } else if (j.contains("position")) {
+    rd.fail(P + "/position",
+            "a " + type + " source has no position (" +
+                (src.type == Source::Type::Box ? "'min' and 'max'" : "its 'file'") + " place it)");
+  }
+  read_surface_source(rd, j, P, type, src);
+  const bool surface = is_surface(src.type);
   if (src.type == Source::Type::Isotropic || surface) {
     if (j.contains("direction"))
-      rd.fail(P + "/direction", "a" + std::string(surface ? " " : "n ") + type +
-                                    " source has no direction (it emits from its surface)");
+      rd.fail(P + "/direction",
+              surface ? "a " + type + " source has no direction (it emits from its surface)"
+                      : std::string("an isotropic source has no direction"));
   } else {
     if (!j.contains("direction")) rd.fail(P + "/direction", "required for a " + type + " source");
     src.direction = normalize(rd.vec3(j["direction"], P + "/direction", true));

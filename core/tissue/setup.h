@@ -1,6 +1,7 @@
 #pragma once
 // Everything a tissue-optics run needs (docs/tissue.md): the labelled volume, the boundary
 // model, the pulsed source, the time gates and the tallies.
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -20,13 +21,17 @@ namespace femto::tissue {
 /// (in the outside index) to the first tissue voxel. Spot: the camera scenes' spot light (emitted
 /// through core/lights.h), directions uniform in its cone weighted by its smooth falloff.
 struct Source {
-  enum class Type { Pencil, Gaussian, Disk, Isotropic, Spot, Sphere, Quad };
+  enum class Type { Pencil, Gaussian, Disk, Isotropic, Spot, Sphere, Quad, Box, Mesh };
   Type type = Type::Pencil;
   Vec3 position{0, 0, 0};         ///< sphere: its centre; quad: its corner
   Vec3 direction{0, 0, 1};        ///< unit; unused by isotropic, sphere and quad
   double waist = 0;               ///< gaussian: 1/e^2 intensity radius, mm
   double radius = 0;              ///< disk, sphere: radius, mm
   Vec3 edge1{0, 0, 0}, edge2{0, 0, 0};  ///< quad: its edges; it emits along edge1 x edge2
+  Vec3 box_min{0, 0, 0}, box_max{0, 0, 0};  ///< box: its corners; it emits outwards
+  /// mesh: its triangles (mm, from the file), each emitting along its normal (right-hand rule)
+  std::vector<Vec3> mesh_vertices;
+  std::vector<std::array<uint32_t, 3>> mesh_triangles;
   double cone_angle_deg = 30;     ///< spot: half-angle of the cone
   double falloff_start_deg = 24;  ///< spot: half-angle where the smooth falloff starts
   double fwhm_ps = 0;             ///< Gaussian pulse FWHM; 0 = delta pulse
@@ -34,6 +39,12 @@ struct Source {
   bool specular = false;  ///< remove the Fresnel reflection at the entry surface from the weight
   double sigma_ps() const { return fwhm_ps / 2.3548200450309493; }
 };
+
+/// Sources that emit from a surface (the camera scenes' emissive shapes).
+inline bool is_surface(Source::Type t) {
+  return t == Source::Type::Sphere || t == Source::Type::Quad || t == Source::Type::Box ||
+         t == Source::Type::Mesh;
+}
 
 /// A disc detector on the tissue surface: photons leaving the tissue through a voxel face in the
 /// plane of `center` and within `radius` of it are detected, if their exit direction lies within

@@ -48,17 +48,13 @@ struct WalkOptics {
   double inv_mu_s = kInf, inv_mu_t = kInf, inv_v = 1 / kSpeedOfLight;
   HgCosSampler hg;  ///< the scattering cosine's constants for g
   static WalkOptics of(double mu_a, double mu_s, double g, double n) {
+    return of(mu_a, mu_s, g, n, HgCosSampler::of(g));
+  }
+  /// With hg = HgCosSampler::of(g) worked out already (optics computed per step).
+  static WalkOptics of(double mu_a, double mu_s, double g, double n, const HgCosSampler& hg) {
     const double mu_t = mu_a + mu_s, v = kSpeedOfLight / n;
-    return {mu_a,
-            mu_s,
-            mu_t,
-            g,
-            n,
-            v,
-            mu_s > 0 ? 1 / mu_s : kInf,
-            mu_t > 0 ? 1 / mu_t : kInf,
-            1 / v,
-            HgCosSampler::of(g)};
+    return {mu_a,  mu_s, mu_t, g, n, v, mu_s > 0 ? 1 / mu_s : kInf, mu_t > 0 ? 1 / mu_t : kInf,
+            1 / v, hg};
   }
   static WalkOptics of(const TissueOptics& o) { return of(o.mu_a, o.mu_s, o.g, o.n); }
 };

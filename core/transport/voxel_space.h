@@ -14,7 +14,7 @@ class VoxelSpace {
   /// `volume.voxel_optics` holds the optics; every voxel has label 1; optics[0].n is outside and
   /// optics[1].g the medium's anisotropy.
   VoxelSpace(const LabelVolume& volume, bool fresnel)
-      : vol_(volume), fresnel_(fresnel), g_(volume.optics.at(1).g) {
+      : vol_(volume), fresnel_(fresnel), g_(volume.optics.at(1).g), hg_(HgCosSampler::of(g_)) {
     outside_ = WalkOptics::of(volume.optics.at(0));
   }
   const LabelVolume& volume() const { return vol_; }
@@ -24,7 +24,7 @@ class VoxelSpace {
   WalkOptics optics_at(const Photon& p) const {
     if (p.label == 0) return outside_;
     const VoxelOptics& v = voxel(p.cell);
-    return WalkOptics::of(v.mu_a, v.mu_s, g_, v.n);
+    return WalkOptics::of(v.mu_a, v.mu_s, g_, v.n, hg_);
   }
 
   /// As LabelSpace::distance_to_interface, with "the same optics" in place of "the same label".
@@ -56,6 +56,7 @@ class VoxelSpace {
   const LabelVolume& vol_;
   bool fresnel_;
   double g_;
+  HgCosSampler hg_;  // g_'s: optics_at builds WalkOptics per step
   WalkOptics outside_;
 };
 
