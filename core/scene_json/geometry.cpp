@@ -1,9 +1,13 @@
-// Shape geometry: transforms read and applied, the triangles of a box, the closed-mesh check.
+// Shape geometry: transforms read and applied, the triangles of a quad and a box, mesh files, the
+// closed-mesh check.
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include "core/constants.h"
 #include "core/error.h"
+#include "core/io/ply.h"
+#include "core/obj_loader.h"
 #include "core/scene_json/loader.h"
 
 namespace femto::scene_json {
@@ -37,6 +41,18 @@ Vec3 face_normal(const std::vector<Vec3>& v, const std::array<uint32_t, 3>& t) {
 }
 
 }  // namespace
+
+void make_quad(const Vec3& corner, const Vec3& e1, const Vec3& e2, ShapeDesc& s) {
+  s.vertices = {corner, corner + e1, corner + e1 + e2, corner + e2};
+  s.triangles = {{0, 1, 2}, {0, 2, 3}};  // both have normal along e1 x e2
+}
+
+void load_mesh_file(const std::string& path, ShapeDesc& s) {
+  if (std::filesystem::path(path).extension() == ".ply")
+    load_ply(path, s.vertices, s.triangles);
+  else
+    load_obj(path, s.vertices, s.triangles);
+}
 
 void make_box(const Vec3& lo, const Vec3& hi, ShapeDesc& s) {
   s.vertices.clear();

@@ -11,6 +11,7 @@
 
 #include "core/constants.h"
 #include "core/scene_desc.h"
+#include "core/scene_json/shape_builders.h"
 
 namespace femto::scene_json {
 
@@ -75,7 +76,6 @@ struct Transform {
 };
 
 void apply_transform(const Transform& tf, ShapeDesc& s);
-void make_box(const Vec3& lo, const Vec3& hi, ShapeDesc& s);
 std::string closed_mesh_problem(const std::vector<Vec3>& v,
                                 const std::vector<std::array<uint32_t, 3>>& tris);
 

@@ -3,8 +3,6 @@
 #include <filesystem>
 
 #include "core/error.h"
-#include "core/io/ply.h"
-#include "core/obj_loader.h"
 #include "core/scene_json/loader.h"
 
 namespace femto::scene_json {
@@ -56,8 +54,7 @@ ShapeDesc Loader::shape(const Json& v, const std::string& p, const SceneDesc& sc
     // Relative test: the sine of the angle between the edges must not vanish.
     if (length(cross(e1, e2)) <= 1e-9 * length(e1) * length(e2))
       fail(at(p, "edge2"), "parallel to edge1 " + fmt(e1) + ", so the quad is degenerate", je2);
-    s.vertices = {c, c + e1, c + e1 + e2, c + e2};
-    s.triangles = {{0, 1, 2}, {0, 2, 3}};  // both have normal along edge1 x edge2
+    make_quad(c, e1, e2, s);
   } else if (type == "box") {
     check_keys(o, p, join(common, {"min", "max"}), "a box", specific);
     s.type = ShapeDesc::Type::Box;
@@ -78,10 +75,7 @@ ShapeDesc Loader::shape(const Json& v, const std::string& p, const SceneDesc& sc
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) fail(fp, "mesh file not found: " + clip(path, 200), jf);
     try {
-      if (fs::path(path).extension() == ".ply")
-        load_ply(path, s.vertices, s.triangles);
-      else
-        load_obj(path, s.vertices, s.triangles);
+      load_mesh_file(path, s);
     } catch (const InputError& e) {
       fail(fp, e.what());
     }

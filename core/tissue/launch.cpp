@@ -6,7 +6,7 @@
 
 #include "core/bsdf/fresnel.h"
 #include "core/sampling.h"
-#include "core/scene_json/loader.h"  // make_box
+#include "core/scene_json/shape_builders.h"
 #include "core/sincos_2pi.h"
 #include "core/transport/voxel_space.h"
 #include "media/grid_medium.h"  // clamped_floor
@@ -33,12 +33,10 @@ Emitter::Emitter(const Source& src) {
       sh.radius = src.radius;
     } else if (src.type == Source::Type::Quad) {
       sh.type = ShapeDesc::Type::Quad;
-      const Vec3 o = src.position;
-      sh.vertices = {o, o + src.edge1, o + src.edge1 + src.edge2, o + src.edge2};
-      sh.triangles = {{0, 1, 2}, {0, 2, 3}};  // normal edge1 x edge2, as the camera scenes' quad
+      scene_json::make_quad(src.position, src.edge1, src.edge2, sh);
     } else if (src.type == Source::Type::Box) {
       sh.type = ShapeDesc::Type::Box;
-      scene_json::make_box(src.box_min, src.box_max, sh);  // faces point outwards
+      scene_json::make_box(src.box_min, src.box_max, sh);
     } else {
       sh.type = ShapeDesc::Type::Mesh;
       sh.vertices = src.mesh_vertices;

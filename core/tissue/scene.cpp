@@ -10,8 +10,7 @@
 #include "core/constants.h"
 #include "core/error.h"
 #include "core/io/nifti.h"
-#include "core/io/ply.h"
-#include "core/obj_loader.h"
+#include "core/scene_json/shape_builders.h"
 #include "media/label_grid_vdb.h"
 #include "media/volume_data.h"
 
@@ -344,14 +343,14 @@ void read_surface_source(const Reader& rd, const Json& j, const std::string& P,
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     rd.fail(P + "/file", "mesh file not found: " + clip(path, 200), j["file"]);
+  ShapeDesc mesh_shape;
   try {
-    if (std::filesystem::path(path).extension() == ".ply")
-      load_ply(path, src.mesh_vertices, src.mesh_triangles);
-    else
-      load_obj(path, src.mesh_vertices, src.mesh_triangles);
+    scene_json::load_mesh_file(path, mesh_shape);
   } catch (const InputError& e) {
     rd.fail(P + "/file", e.what());
   }
+  src.mesh_vertices = std::move(mesh_shape.vertices);
+  src.mesh_triangles = std::move(mesh_shape.triangles);
   double area = 0;
   for (const auto& t : src.mesh_triangles)
     area += length(cross(src.mesh_vertices[t[1]] - src.mesh_vertices[t[0]],
