@@ -111,7 +111,18 @@ double percentile(std::vector<double> v, double q) {
   return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
-void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells) {
+/// Options that shape a scene's run.
+struct RunOptions {
+  int reps = 8;
+  double spp_scale = 1.0;
+  bool all_cells = false;
+  bool deciles = false;  ///< also "default vs it" per tenth of the window
+};
+
+void run_scene(const BenchScene& bs, const RunOptions& ro) {
+  const int reps = ro.reps;
+  const double spp_scale = ro.spp_scale;
+  const bool all_cells = ro.all_cells;
   SceneDesc base;
   try {
     base = load_scene_string(bs.json, bs.name, ".");
@@ -304,6 +315,23 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
                 sum_mse > 0 ? (sum_mse_c * time_c) / (sum_mse * t) : 0.0, tm, std::sqrt(tv / reps),
                 vs_def.empty() ? 0.0 : median(vs_def),
                 vs_def_block.empty() ? 0.0 : median(vs_def_block));
+    if (ro.deciles && k != c_def) {
+      // Where in the window the default wins or loses against this configuration: the same
+      // cell-by-cell median, per tenth of the bins.
+      std::printf("    default vs it by tenth of the window:");
+      for (int q = 0; q < 10; ++q) {
+        std::vector<double> v;
+        for (size_t i = 0; i < cells; ++i)
+          if (static_cast<int>(i % static_cast<size_t>(bins)) * 10 / bins == q &&
+              ref[i] > min_signal * peak && mse[i] > 0 && mse_def[i] > 0)
+            v.push_back((mse[i] * t) / (mse_def[i] * time_def));
+        if (v.empty())
+          std::printf("     -");
+        else
+          std::printf(" %5.2f", median(v));
+      }
+      std::printf("\n");
+    }
     std::fflush(stdout);
   }
 }
@@ -311,29 +339,29 @@ void run_scene(const BenchScene& bs, int reps, double spp_scale, bool all_cells)
 }  // namespace
 
 int main(int argc, char** argv) {
-  int reps = 8;
-  double spp_scale = 1.0;
+  RunOptions ro;
   std::string only;
-  bool all_cells = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--reps" && i + 1 < argc) {
-      reps = std::atoi(argv[++i]);
+      ro.reps = std::atoi(argv[++i]);
     } else if (a == "--spp-scale" && i + 1 < argc) {
-      spp_scale = std::atof(argv[++i]);
+      ro.spp_scale = std::atof(argv[++i]);
     } else if (a == "--scene" && i + 1 < argc) {
       only = argv[++i];
     } else if (a == "--all-cells") {
-      all_cells = true;  // every cell with light counts, as in the corridors
+      ro.all_cells = true;  // every cell with light counts, as in the corridors
+    } else if (a == "--deciles") {
+      ro.deciles = true;
     } else {
       std::fprintf(stderr,
                    "usage: femto-bench-sampling [--reps N (seeds, >= 3)] [--spp-scale X] "
-                   "[--scene NAME] [--all-cells]  (run from the repository root: the cloud reads "
-                   "data/volumes/cloud.vdb)\n");
+                   "[--scene NAME] [--all-cells] [--deciles]  (run from the repository root: "
+                   "the cloud reads data/volumes/cloud.vdb)\n");
       return 2;
     }
   }
-  if (reps < 3 || !(spp_scale > 0)) {
+  if (ro.reps < 3 || !(ro.spp_scale > 0)) {
     std::fprintf(stderr, "femto-bench-sampling: --reps must be >= 3 and --spp-scale > 0\n");
     return 2;
   }
@@ -392,6 +420,6 @@ int main(int argc, char** argv) {
       "collision over the configuration's, per pixel-bin cell (> 1: better); * = default\n",
       cpu_model().c_str());
   for (const BenchScene& bs : list)
-    if (only.empty() || only == bs.name) run_scene(bs, reps, spp_scale, all_cells);
+    if (only.empty() || only == bs.name) run_scene(bs, ro);
   return 0;
 }

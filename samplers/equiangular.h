@@ -20,6 +20,8 @@ namespace femto {
 
 class EquiangularSampler {
  public:
+  /// No segment: valid() is false.
+  EquiangularSampler() = default;
   /// w must be unit length; [s_a, s_b] finite with s_a < s_b, otherwise valid() is false.
   EquiangularSampler(const Vec3& o, const Vec3& w, const Vec3& p, double s_a, double s_b)
       : s_a_(s_a), s_b_(s_b) {
@@ -76,7 +78,7 @@ class EquiangularSampler {
   }
 
  private:
-  double s_a_, s_b_;
+  double s_a_ = 0, s_b_ = 0;
   double delta_ = 0, h_ = 0, a_ = 0, b_ = 0, theta_ = 0;
   bool limit_ = false, valid_ = false;
 };

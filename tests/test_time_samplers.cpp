@@ -143,6 +143,12 @@ TEST_CASE("equiangular: no sample when the target lies on the segment",
   CHECK_FALSE(femto::EquiangularSampler(kO, kW, Vec3(1, 0, 3), 5.0, 5.0).valid());
   CHECK_FALSE(femto::EquiangularSampler(kO, kW, Vec3(1, 0, 3), 0.0, kInf).valid());
   CHECK(femto::EquiangularSampler(kO, kW, Vec3(0, 0, 3), 4.0, 10.0).valid());  // off the segment
+  // No segment at all (the connections' placeholder where equiangular sampling is not used): a
+  // density that some MIS sum would add must be zero.
+  const femto::EquiangularSampler none;
+  CHECK_FALSE(none.valid());
+  CHECK(none.pdf(0.0) == 0.0);
+  CHECK(none.pdf(1.0) == 0.0);
 }
 
 // ---------------------------------------------------------------- line-to-point

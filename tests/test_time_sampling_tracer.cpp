@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "core/constants.h"
 #include "core/integrators/connection_choice.h"
+#include "core/rng.h"
 #include "core/scene.h"
 #include "core/scene_loader.h"
 #include "media/volume_data.h"
@@ -217,9 +219,103 @@ TEST_CASE("auto connects the segments whose light term peaks narrowly", "[time-s
   CHECK(connect_segment_to(o, d, std::numeric_limits<double>::infinity(), 0.0, {1e3, 1e3, 0}));
 }
 
+// Catches: a bound in box_far_from_light that is too small (auto would skip the first rule on a
+// medium where some segment should connect: fireflies near the light come back) or one that
+// never holds (the shortcut that spares a dense medium's segments the rule would never fire).
+// Segments start anywhere in the box, in any direction, and run to the box's wall; the light is
+// anywhere outside, from just beyond the bound to a few times it; the extinction is the
+// medium's (homogeneous) or any value at the segment's start (voxel media: unknown).
+TEST_CASE("no segment inside a box connects to a light the box is far from", "[time-sampling]") {
+  Rng rng(20261203, 1);
+  int far = 0, near_edge = 0, segments = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const Vec3 lo(rng.uniform() * 10 - 5, rng.uniform() * 10 - 5, rng.uniform() * 10 - 5);
+    const Vec3 hi =
+        lo + Vec3(0.1 + rng.uniform() * 20, 0.1 + rng.uniform() * 20, 0.1 + rng.uniform() * 20);
+    const bool homogeneous = trial % 2 == 0;
+    const double sigma_t = std::pow(10.0, rng.uniform() * 4 - 2);  // 0.01 to 100 per mm
+    double bound = kConnectionPeakFraction * length(hi - lo);
+    if (homogeneous) bound = std::fmin(bound, kConnectionPeakFraction / sigma_t);
+    // A light off the middle of a random face, 0.3 to 3 bounds away from it.
+    const int axis = trial % 3, side = (trial / 3) % 2;
+    Vec3 p((lo.x + hi.x) / 2, (lo.y + hi.y) / 2, (lo.z + hi.z) / 2);
+    const double gap = bound * (0.3 + 2.7 * rng.uniform());
+    (axis == 0   ? p.x
+     : axis == 1 ? p.y
+                 : p.z) = side ? (axis == 0   ? hi.x
+                                  : axis == 1 ? hi.y
+                                              : hi.z) +
+                                     gap
+                               : (axis == 0   ? lo.x
+                                  : axis == 1 ? lo.y
+                                              : lo.z) -
+                                     gap;
+    const bool is_far = box_far_from_light(lo, hi, homogeneous ? sigma_t : 0.0, p);
+    if (gap > 1.011 * bound) CHECK(is_far);  // no looser than the bound with its 1% slack
+    if (!is_far) continue;
+    ++far;
+    near_edge += gap < 1.1 * bound;
+    for (int k = 0; k < 50; ++k, ++segments) {
+      // Half start anywhere, half just inside the face below the light (the worst case).
+      Vec3 o(lo.x + rng.uniform() * (hi.x - lo.x), lo.y + rng.uniform() * (hi.y - lo.y),
+             lo.z + rng.uniform() * (hi.z - lo.z));
+      if (k % 2) {
+        const double width = axis == 0 ? hi.x - lo.x : axis == 1 ? hi.y - lo.y : hi.z - lo.z;
+        const double inset = std::fmin(bound, width) * rng.uniform() * rng.uniform();
+        double& c = axis == 0 ? o.x : axis == 1 ? o.y : o.z;
+        c = side ? (axis == 0   ? hi.x
+                    : axis == 1 ? hi.y
+                                : hi.z) -
+                       inset
+                 : (axis == 0   ? lo.x
+                    : axis == 1 ? lo.y
+                                : lo.z) +
+                       inset;
+      }
+      const double z = 2 * rng.uniform() - 1, phi = 2 * kPi * rng.uniform();
+      const double r = std::sqrt(1 - z * z);
+      const Vec3 d(r * std::cos(phi), r * std::sin(phi), z);
+      double s_full = kInf;  // to the box's wall
+      for (double t : {((d.x > 0 ? hi.x : lo.x) - o.x) / d.x, ((d.y > 0 ? hi.y : lo.y) - o.y) / d.y,
+                       ((d.z > 0 ? hi.z : lo.z) - o.z) / d.z})
+        if (t >= 0) s_full = std::fmin(s_full, t);
+      const double sigma_o = homogeneous ? sigma_t : std::pow(10.0, rng.uniform() * 6 - 3);
+      CHECK_FALSE(connect_segment_to(o, d, s_full, sigma_o, p));
+    }
+    // And the worst case: a segment across the whole face, just inside it, under the light.
+    {
+      const int ta = (axis + 1) % 3;  // a tangent axis
+      const double width = axis == 0 ? hi.x - lo.x : axis == 1 ? hi.y - lo.y : hi.z - lo.z;
+      Vec3 o = p, d(0, 0, 0);
+      double& c = axis == 0 ? o.x : axis == 1 ? o.y : o.z;
+      c = side ? (axis == 0   ? hi.x
+                  : axis == 1 ? hi.y
+                              : hi.z) -
+                     1e-3 * std::fmin(bound, width)
+               : (axis == 0   ? lo.x
+                  : axis == 1 ? lo.y
+                              : lo.z) +
+                     1e-3 * std::fmin(bound, width);
+      (ta == 0 ? o.x : ta == 1 ? o.y : o.z) = ta == 0 ? lo.x : ta == 1 ? lo.y : lo.z;
+      (ta == 0 ? d.x : ta == 1 ? d.y : d.z) = 1.0;
+      const double s_full = ta == 0 ? hi.x - lo.x : ta == 1 ? hi.y - lo.y : hi.z - lo.z;
+      CHECK_FALSE(connect_segment_to(o, d, s_full, homogeneous ? sigma_t : 1.0 / s_full, p));
+    }
+  }
+  CHECK(far > 2500);
+  CHECK(near_edge > 100);  // the edge of the bound is exercised
+  // Closer than the bound, a segment along the face below the light connects, and the box is
+  // not far: the bound is not loose by much.
+  const Vec3 lo(0, 0, 0), hi(10, 10, 10), p(5, 5, 10.05);
+  CHECK_FALSE(box_far_from_light(lo, hi, 1.0, p));                  // 0.05 < 0.1 mean free path
+  CHECK(connect_segment_to({5, 5, 9.99}, {1, 0, 0}, 3.0, 1.0, p));  // 0.06 from the line
+  CHECK(box_far_from_light(lo, hi, 1.0, {5, 5, 10.11}));
+}
+
 // Catches: the starvation rule reading the window or the extinction wrongly (a camera segment
-// that spans many mean free paths handed to collisions alone, or a short one given a needless
-// connection), and the light's side of the segment start read with the wrong sign.
+// that spans many mean free paths handed to collisions alone, or a short one or one deep in a
+// dense medium given a needless connection), and the light's side of the segment start read with
+// the wrong sign.
 TEST_CASE("auto adds line-to-point on camera segments whose late frames starve",
           "[time-sampling]") {
   // sigma_t x min(segment, budget) against 3 mean free paths.
@@ -227,6 +323,14 @@ TEST_CASE("auto adds line-to-point on camera segments whose late frames starve",
   CHECK_FALSE(starved_segment(1000.0, 500.0, 0.004));  // the window ends after 2
   CHECK_FALSE(starved_segment(200.0, 1e4, 0.01));      // the medium ends after 2
   CHECK(starved_segment(std::numeric_limits<double>::infinity(), 150.0, 0.06));
+  // ... but not where the window reaches so deep that light scattered once along the segment is
+  // nil there (the tissue bench: mu_t 10/mm, 20 mm of block, 33 mm of window: 200 mean free
+  // paths).
+  const double endless = std::numeric_limits<double>::infinity();
+  CHECK(starved_segment(endless, 3990.0, 0.004));  // 15.96 mean free paths
+  CHECK_FALSE(starved_segment(endless, 4010.0, 0.004));
+  CHECK_FALSE(starved_segment(5000.0, 4010.0, 0.004));
+  CHECK_FALSE(starved_segment(20.0, 33.0, 10.01));
   // The light behind (or level with) the segment's start lights it from there on.
   const Vec3 o(0, 0, 0), d(0, 0, -1);
   CHECK(lights_from_start(o, d, {0, 4, 30}));

@@ -10,11 +10,11 @@
 // collisions rarely hit, while equiangular sampling spreads over the light's angles and so over
 // the cone. The choice depends only on the segment and the light, never on a sampled distance, so
 // the two estimators split the light between them without bias.
-// Second rule, for the frames a camera segment reaches late: when its reachable part spans many
-// mean free paths and the light lies behind its start (a source beside the camera: the light
+// Second rule, for the frames a camera segment reaches late: when its reachable part spans 3 to
+// 16 mean free paths and the light lies behind its start (a source beside the camera: the light
 // term falls from the start on and covers all the segment's frames), collisions leave the late
-// frames almost empty. Such a segment keeps its collisions and adds one line-to-point connection
-// (uniform in time), the two weighted by the balance heuristic.
+// frames almost empty. Such a segment keeps its collisions and adds one
+// line-to-point connection (uniform in time), the two weighted by the balance heuristic.
 // Third rule, for media less than a mean free path across (a bank of thin fog) lit only by
 // lights outside every scattering medium: a segment there whose reachable part has optical depth
 // between 0.1 and 1 gets the same pair, whatever side the light is on. Fewer than 1 - 1/e of such
@@ -67,16 +67,37 @@ inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, doub
   return mfp_spread ? w2 * sigma_t * sigma_t < k2 : w2 < k2 * s_full * s_full;
 }
 
+/// Whether no segment inside the box [lo, hi] can connect to the point light at p under
+/// connect_segment_to, wherever it starts and however long it is: its spread is at most the
+/// box's diagonal and, where the extinction is sigma_t everywhere (homogeneous; 0: unknown), at
+/// most the mean free path, and the light's distance from the segment at least its distance from
+/// the box (1% of slack for rounding). A light outside a dense medium (a source in front of
+/// tissue) is far: then the rule need not be asked on the medium's many short segments.
+inline bool box_far_from_light(const Vec3& lo, const Vec3& hi, double sigma_t, const Vec3& p) {
+  double spread = length(hi - lo);
+  if (sigma_t > 0) spread = std::fmin(spread, 1.0 / sigma_t);
+  const double k = 1.01 * kConnectionPeakFraction * spread;
+  const Vec3 gap = vmax(vmax(lo - p, p - hi), Vec3(0.0));
+  return length_squared(gap) >= k * k;
+}
+
 /// Optical depth of a camera segment's reachable part beyond which auto adds a line-to-point
 /// connection: collisions put a fraction exp(-tau) of their density at depth tau, so the frames
 /// that look there get few vertices, while line-to-point sampling is uniform in time.
 constexpr double kStarvedDepth = 3.0;
+/// ... and up to which it does: the connection gathers light scattered once along the segment,
+/// which falls as exp(-2 tau) with depth. Where the window reaches more than 16 mean free paths
+/// into a medium (tissue: 200), most connections land where that light is below 1e-14 of the
+/// first frames' and multiply scattered light fills the frames: a shadow ray per path for nothing
+/// (4-7% of the tissue scene's time in femto-bench-sampling).
+constexpr double kStarvedMaxDepth = 16.0;
 
 /// Whether a camera segment of length s_surf, with extinction sigma_t (spread_sigma_t) and
 /// `budget` mm of light travel left in the window, spans so many mean free paths that its later
-/// frames starve under collision sampling.
+/// frames starve under collision sampling, yet few enough for its single scattering to count.
 inline bool starved_segment(double s_surf, double budget, double sigma_t) {
-  return sigma_t * std::fmin(s_surf, budget) >= kStarvedDepth;
+  const double tau = sigma_t * std::fmin(s_surf, budget);
+  return tau >= kStarvedDepth && tau < kStarvedMaxDepth;
 }
 
 /// Optical depths of a segment's reachable part between which auto adds a line-to-point

@@ -197,11 +197,14 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Connect
                                        : line_to_point_target(med, segment, L, use_lp);
   const double s_end = target.s_end;
   if (!(s_end > 0)) return;
-  // A spot lights only the stretch of the segment inside its cone (core/spot_cone.h).
+  // A spot lights only the stretch of the segment inside its cone (core/spot_cone.h). The
+  // equiangular sampler (an atan2) is made only where it is used.
   double eq_a = 0.0, eq_b = s_end;
-  const bool lit = L.type != Light::Type::Spot || spot_cone_interval(L, ray, eq_a, eq_b);
-  const EquiangularSampler eq(ray.o, ray.d, p, eq_a, eq_b);
-  const bool eq_ok = use_eq && lit && eq.valid(), lp_ok = use_lp && target.valid;
+  const bool eq_lit =
+      use_eq && (L.type != Light::Type::Spot || spot_cone_interval(L, ray, eq_a, eq_b));
+  const EquiangularSampler eq =
+      eq_lit ? EquiangularSampler(ray.o, ray.d, p, eq_a, eq_b) : EquiangularSampler();
+  const bool eq_ok = eq.valid(), lp_ok = use_lp && target.valid;
 
   auto contribute = [&](double s) {
     if (!(s < s_end)) return;

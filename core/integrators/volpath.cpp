@@ -16,17 +16,11 @@ namespace femto {
 
 namespace {
 
-// connection_choice.h, third rule, per medium: every point and spot light sits in a medium that
-// does not scatter, and the medium is thinner than kThinDepth across the bounding box of the
-// shapes that bound it (the global medium, unbounded, never is).
-std::vector<char> thin_media_lit_from_outside(const Scene& scene, const std::vector<int>& lights) {
-  const std::vector<Medium>& media = scene.media();
-  std::vector<char> thin(media.size(), 0);
-  if (lights.empty()) return thin;
-  for (int i : lights)
-    if (media[static_cast<size_t>(scene.medium_at(scene.lights().light(i).position))].interacts())
-      return thin;
-  std::vector<Vec3> lo(media.size(), Vec3(kInf)), hi(media.size(), Vec3(-kInf));
+// Per medium: the bounding box of the shapes that bound it (lo > hi where none does; the global
+// medium is unbounded).
+void medium_bounds(const Scene& scene, std::vector<Vec3>& lo, std::vector<Vec3>& hi) {
+  lo.assign(scene.media().size(), Vec3(kInf));
+  hi.assign(scene.media().size(), Vec3(-kInf));
   const std::vector<ShapeDesc>& shapes = scene.desc().shapes;
   for (size_t i = 0; i < shapes.size(); ++i) {
     if (!bounds_a_medium(shapes[i])) continue;
@@ -35,16 +29,55 @@ std::vector<char> thin_media_lit_from_outside(const Scene& scene, const std::vec
     shape_bounds(shapes[i], a, b);
     lo[m] = vmin(lo[m], a), hi[m] = vmax(hi[m], b);
   }
+}
+
+bool bounded(const Scene& scene, size_t m, const std::vector<Vec3>& lo,
+             const std::vector<Vec3>& hi) {
+  return static_cast<int>(m) != scene.global_medium() && lo[m].x <= hi[m].x;
+}
+
+// connection_choice.h, third rule, per medium: every point and spot light sits in a medium that
+// does not scatter, and the medium is thinner than kThinDepth across the bounding box of the
+// shapes that bound it (the global medium, unbounded, never is).
+std::vector<char> thin_media_lit_from_outside(const Scene& scene, const std::vector<int>& lights,
+                                              const std::vector<Vec3>& lo,
+                                              const std::vector<Vec3>& hi) {
+  const std::vector<Medium>& media = scene.media();
+  std::vector<char> thin(media.size(), 0);
+  if (lights.empty()) return thin;
+  for (int i : lights)
+    if (media[static_cast<size_t>(scene.medium_at(scene.lights().light(i).position))].interacts())
+      return thin;
   for (size_t m = 0; m < media.size(); ++m) {
     const Medium& med = media[m];
-    if (static_cast<int>(m) == scene.global_medium() || !med.interacts() || !(lo[m].x <= hi[m].x))
-      continue;
+    if (!med.interacts() || !bounded(scene, m, lo, hi)) continue;
     const double width = std::min({hi[m].x - lo[m].x, hi[m].y - lo[m].y, hi[m].z - lo[m].z});
     const double sigma_t =
         med.type == Medium::Type::Grid ? med.grid->mean_sigma_t() : med.homogeneous.sigma_t();
     thin[m] = sigma_t * width < kThinDepth;
   }
   return thin;
+}
+
+// connection_choice.h, first rule, per medium: every point light (spots always connect) is
+// box_far_from_light of the bounding box of the medium's shapes, which its segments stay in.
+std::vector<char> media_far_from_lights(const Scene& scene, const std::vector<int>& lights,
+                                        const std::vector<Vec3>& lo, const std::vector<Vec3>& hi) {
+  const std::vector<Medium>& media = scene.media();
+  std::vector<char> far(media.size(), 0);
+  for (size_t m = 0; m < media.size(); ++m) {
+    const Medium& med = media[m];
+    if (!med.interacts() || !bounded(scene, m, lo, hi)) continue;
+    const double sigma_t = med.type == Medium::Type::Homogeneous ? med.homogeneous.sigma_t() : 0.0;
+    bool all_far = true;
+    for (int i : lights) {
+      const Light& L = scene.lights().light(i);
+      all_far = all_far && L.type != Light::Type::Spot &&
+                box_far_from_light(lo[m], hi[m], sigma_t, L.position);
+    }
+    far[m] = all_far;
+  }
+  return far;
 }
 
 }  // namespace
@@ -69,7 +102,10 @@ VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& f
       total += lights.pmf(i);
     }
   for (double& p : point_pmf_) p /= total;
-  thin_media_ = thin_media_lit_from_outside(scene, point_lights_);
+  std::vector<Vec3> lo, hi;
+  medium_bounds(scene, lo, hi);
+  thin_media_ = thin_media_lit_from_outside(scene, point_lights_, lo, hi);
+  far_media_ = media_far_from_lights(scene, point_lights_, lo, hi);
 }
 
 void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
@@ -107,9 +143,14 @@ void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, d
     segment.active = true;
     return;
   }
+  const bool mfp = med.strategy.kind == DistanceSampling::Mfp;
+  const size_t mi = static_cast<size_t>(m);
+  if (far_media_[mi] && !(mfp && (camera_segment || thin_media_[mi]))) {
+    segment.decided = point_lights_.size() == 1;  // and no rule applies
+    return;
+  }
   segment.sigma_t = spread_sigma_t(med, ray.o);
   const double budget = kSpeedOfLight * (t_cut_ - t);
-  const bool mfp = med.strategy.kind == DistanceSampling::Mfp;
   segment.time_mis = camera_segment && mfp && starved_segment(s_surf, budget, segment.sigma_t);
   segment.thin = !segment.time_mis && mfp && thin_media_[static_cast<size_t>(m)] &&
                  thin_segment(s_surf, budget, segment.sigma_t);

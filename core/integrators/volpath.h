@@ -163,6 +163,9 @@ class VolPathIntegrator {
   std::vector<int> point_lights_;  ///< point and spot lights: targets of angular sampling
   /// Per medium: connection_choice.h's third rule applies (thin_media_lit_from_outside).
   std::vector<char> thin_media_;
+  /// Per medium: no point light can ever connect on its segments under the first rule
+  /// (media_far_from_lights), so plan_segment skips the rules where no other one applies.
+  std::vector<char> far_media_;
   std::vector<double> point_pmf_;  ///< their pick probabilities, proportional to power
 };
 
