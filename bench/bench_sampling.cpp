@@ -277,13 +277,17 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
     const double t = median(secs[static_cast<size_t>(k)]);
     const std::vector<double> mse = mse_of(k);
     std::vector<double> vs_def, vs_def_block;
+    std::vector<std::vector<double>> by_tenth(10);  // vs_def per tenth of the window
     std::vector<double> all, late;
     double sum_mse = 0, sum_mse_c = 0;
     for (size_t i = 0; i < cells; ++i) {
       sum_mse += mse[i];
       sum_mse_c += mse_c[i];
-      if (ref[i] > min_signal * peak && mse[i] > 0 && mse_def[i] > 0)
+      if (ref[i] > min_signal * peak && mse[i] > 0 && mse_def[i] > 0) {
         vs_def.push_back((mse[i] * t) / (mse_def[i] * time_def));
+        by_tenth[static_cast<size_t>(static_cast<int>(i % static_cast<size_t>(bins)) * 10 / bins)]
+            .push_back(vs_def.back());
+      }
       if (!(ref[i] > min_signal * peak && mse[i] > 0 && mse_c[i] > 0)) continue;
       const double e = (mse_c[i] * time_c) / (mse[i] * t);
       all.push_back(e);
@@ -319,17 +323,11 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
       // Where in the window the default wins or loses against this configuration: the same
       // cell-by-cell median, per tenth of the bins.
       std::printf("    default vs it by tenth of the window:");
-      for (int q = 0; q < 10; ++q) {
-        std::vector<double> v;
-        for (size_t i = 0; i < cells; ++i)
-          if (static_cast<int>(i % static_cast<size_t>(bins)) * 10 / bins == q &&
-              ref[i] > min_signal * peak && mse[i] > 0 && mse_def[i] > 0)
-            v.push_back((mse[i] * t) / (mse_def[i] * time_def));
+      for (const std::vector<double>& v : by_tenth)
         if (v.empty())
           std::printf("     -");
         else
           std::printf(" %5.2f", median(v));
-      }
       std::printf("\n");
     }
     std::fflush(stdout);

@@ -13,8 +13,8 @@
 // Second rule, for the frames a camera segment reaches late: when its reachable part spans 3 to
 // 16 mean free paths and the light lies behind its start (a source beside the camera: the light
 // term falls from the start on and covers all the segment's frames), collisions leave the late
-// frames almost empty. Such a segment keeps its collisions and adds one
-// line-to-point connection (uniform in time), the two weighted by the balance heuristic.
+// frames almost empty. Such a segment keeps its collisions and adds one line-to-point connection
+// (uniform in time), the two weighted by the balance heuristic.
 // Third rule, for media less than a mean free path across (a bank of thin fog) lit only by
 // lights outside every scattering medium: a segment there whose reachable part has optical depth
 // between 0.1 and 1 gets the same pair, whatever side the light is on. Fewer than 1 - 1/e of such

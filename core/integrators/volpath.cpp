@@ -152,8 +152,8 @@ void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, d
   segment.sigma_t = spread_sigma_t(med, ray.o);
   const double budget = kSpeedOfLight * (t_cut_ - t);
   segment.time_mis = camera_segment && mfp && starved_segment(s_surf, budget, segment.sigma_t);
-  segment.thin = !segment.time_mis && mfp && thin_media_[static_cast<size_t>(m)] &&
-                 thin_segment(s_surf, budget, segment.sigma_t);
+  segment.thin =
+      !segment.time_mis && mfp && thin_media_[mi] && thin_segment(s_surf, budget, segment.sigma_t);
   segment.time_mis = segment.time_mis || segment.thin;
   const LightSet& lights = scene_.lights();
   for (int li : point_lights_)
