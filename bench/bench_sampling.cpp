@@ -413,6 +413,15 @@ int main(int argc, char** argv) {
   } else {
     std::printf("(no %s here: run from the repository root for the voxel cloud)\n", cloud.c_str());
   }
+  if (!only.empty() && std::none_of(list.begin(), list.end(),
+                                    [&](const BenchScene& bs) { return bs.name == only; })) {
+    std::string names;
+    for (const BenchScene& bs : list)
+      names += std::string(names.empty() ? "\"" : ", \"") + bs.name + "\"";
+    std::fprintf(stderr, "femto-bench-sampling: --scene \"%s\": no such scene (scenes: %s)\n",
+                 only.c_str(), names.c_str());
+    return 2;
+  }
   std::printf(
       "femto-bench-sampling: CPU %s; 1 thread; efficiency = (MSE x time) of mfp + "
       "collision over the configuration's, per pixel-bin cell (> 1: better); * = default\n",
