@@ -46,6 +46,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
   // The latest non-specular vertex, and whether a specular surface came after it.
   enum class Last { Other, Medium, Diffuse } last = Last::Other;
   bool specular_since = false;
+  // Only diffuse surfaces since a photon's vertex (light -> (S|G)+ -> D D*).
+  bool caustic_chain = false;
   // The current medium ray piece's equiangular sensor connection (sensor_rays_).
   bool ray_active = false;
   Ray ray_piece;
@@ -101,9 +103,13 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
         // Light scattered in a medium onto a diffuse surface, straight or through specular
         // surfaces (light -> X* M S* -> D -> sensor), and light from a diffuse surface through
         // specular ones (light -> X* D S+ -> D -> sensor): the caustics of what has scattered.
+        // And the light of a caustic on a diffuse surface reaching the one the camera sees through
+        // diffuse bounces only (light -> (S|G)+ -> D D* -> D -> sensor), which camera paths find
+        // only by the directions of their bounces.
         const bool splat_here =
-            caustic ||
-            (diffuse && (last == Last::Medium || (last == Last::Diffuse && specular_since)));
+            caustic || (diffuse && (last == Last::Medium ||
+                                    (last == Last::Diffuse && specular_since) || caustic_chain));
+        caustic_chain = diffuse && (caustic || caustic_chain);
         if (v.bsdf->is_delta()) {
           specular_since = true;
         } else {
@@ -117,6 +123,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
         if (!v.connection_only) {
           scattered = true;
           last = Last::Medium;
+          caustic_chain = false;
           specular_since = false;
         }
         // Direct light (light -> M) is the camera paths' share.

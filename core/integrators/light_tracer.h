@@ -26,8 +26,9 @@ class LightTracer {
   /// Which vertices are splatted. MediumIndirect: medium vertices whose light sub-path has
   /// scattered (off a diffuse surface or in a medium) or met a surface before, light -> X+ -> M
   /// -> sensor, diffuse surface vertices reached from a medium scattering or a diffuse surface
-  /// through specular ones, light -> X* M S* -> D and light -> X* D S+ -> D, and the light's own
-  /// caustic, light -> (S|G)+ -> D; the hybrid integrator's camera paths leave exactly those
+  /// through specular ones, light -> X* M S* -> D and light -> X* D S+ -> D, the light's own
+  /// caustic, light -> (S|G)+ -> D, and what it lights through diffuse bounces alone, light ->
+  /// (S|G)+ -> D D* -> D; the hybrid integrator's camera paths leave exactly those
   /// paths out (docs/ARCHITECTURE.md, "Path-space partition").
   enum class Vertices { All, MediumIndirect };
   LightTracer(const Scene& scene, int max_depth, double t_cut_ps,

@@ -283,6 +283,9 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
   // and ends at a collision. And light -> X* D S+ -> x_c: the first diffuse surface reached from
   // x_c through specular surfaces ends the path.
   bool from_xd = false, from_xd_specular = false;
+  // And light -> (S|G)+ -> D D* -> x_c (a caustic on a diffuse surface lighting, through diffuse
+  // bounces only, the one the camera sees): no photon gathers along a diffuse chain from x_c.
+  bool diffuse_chain = false;
   ConnectedSegment segment;  // the current segment's connection plan (plan_segment)
 
   for (;;) {
@@ -354,6 +357,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
         on_camera_segment = false;
         last = Last::Medium;
         since = 0;
+        diffuse_chain = false;
         ++stats.medium_events;
         if (depth >= max_depth_) {
           ++stats.max_depth_hits;
@@ -411,8 +415,11 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     const Frame frame(hit.ng);
     const Vec3 wo = frame.to_local(-ray.d);
     const bool wo_outside = front;
-    // At x_c a diffuse surface light tracing owns the photons' light -> (S|G)+ -> x_c too.
-    if (photons && bsdf.is_diffuse() && !(light_indirect && first_vertex))
+    // At x_c a diffuse surface light tracing owns the photons' light -> (S|G)+ -> x_c too, and
+    // along a diffuse chain from it light -> (S|G)+ -> D D* -> x_c (a bright caustic lighting what
+    // the camera sees, which camera paths find only by the directions of their bounces).
+    if (first_vertex) diffuse_chain = light_indirect && bsdf.is_diffuse();
+    if (photons && bsdf.is_diffuse() && !(light_indirect && (first_vertex || diffuse_chain)))
       photons->gather(bsdf, hit, frame, wo, beta, t, acc, stats);
     // Next-event estimation, except where a photon owns the path (light -> glossy -> diffuse).
     if (!bsdf.is_delta() && !(!bsdf.is_diffuse() && owned(last)))
@@ -424,6 +431,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       ++since;
     }
     if (!bsdf.is_delta()) beam_prefix = false;
+    diffuse_chain = diffuse_chain && bsdf.is_diffuse();
     from_xd_specular = from_xd && bsdf.is_delta();
     from_xd =
         light_indirect && ((first_vertex && bsdf.is_diffuse()) || (from_xd && bsdf.is_delta()));
