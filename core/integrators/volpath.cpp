@@ -418,7 +418,6 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
     // At x_c a diffuse surface light tracing owns the photons' light -> (S|G)+ -> x_c too, and
     // along a diffuse chain from it light -> (S|G)+ -> D D* -> x_c (a bright caustic lighting what
     // the camera sees, which camera paths find only by the directions of their bounces).
-    if (first_vertex) diffuse_chain = light_indirect && bsdf.is_diffuse();
     if (photons && bsdf.is_diffuse() && !(light_indirect && (first_vertex || diffuse_chain)))
       photons->gather(bsdf, hit, frame, wo, beta, t, acc, stats);
     // Next-event estimation, except where a photon owns the path (light -> glossy -> diffuse).
@@ -431,7 +430,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       ++since;
     }
     if (!bsdf.is_delta()) beam_prefix = false;
-    diffuse_chain = diffuse_chain && bsdf.is_diffuse();
+    diffuse_chain = light_indirect && bsdf.is_diffuse() && (first_vertex || diffuse_chain);
     from_xd_specular = from_xd && bsdf.is_delta();
     from_xd =
         light_indirect && ((first_vertex && bsdf.is_diffuse()) || (from_xd && bsdf.is_delta()));
