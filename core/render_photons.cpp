@@ -85,9 +85,14 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   // Hybrid: light paths splatted from their medium vertices once they have scattered (off a
   // diffuse surface or in a medium) or met a surface, and from the diffuse surface vertices the
   // partition gives them, which camera paths then leave out: one light path per four pixels per
-  // pass (docs/ARCHITECTURE.md, "Path-space partition"). With neither a scattering medium nor a
-  // diffuse surface they would splat nothing.
-  const bool light_indirect = hybrid && (caustic_beams || trace_surface_photons);
+  // pass (docs/ARCHITECTURE.md, "Path-space partition"). With no scattering medium, diffuse
+  // surface or glossy surface they would splat nothing.
+  const bool glossy_surface =
+      std::any_of(scene.desc().shapes.begin(), scene.desc().shapes.end(), [](const ShapeDesc& sh) {
+        return sh.material.type == MaterialDesc::Type::RoughConductor ||
+               sh.material.type == MaterialDesc::Type::RoughDielectric;
+      });
+  const bool light_indirect = hybrid && (caustic_beams || trace_surface_photons || glossy_surface);
   const int64_t indirect_paths = hybrid_light_paths_per_pass(opt, static_cast<int64_t>(W) * H);
   // Photon times include the emission offset: the window end plus the widest pulse spread.
   const double photon_t_cut = axis.t_end_ps() + 8.0 * scene.lights().max_sigma_ps();

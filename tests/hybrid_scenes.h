@@ -1,7 +1,10 @@
 #pragma once
-// A scene shared by the hybrid's tests (tests/test_hybrid.cpp, tests/test_hybrid_light_tracing.cpp).
+// A scene and a mask shared by the hybrid's tests (tests/test_hybrid.cpp,
+// tests/test_hybrid_light_tracing.cpp, tests/test_hybrid_glossy.cpp).
 #include <string>
+#include <vector>
 
+#include "core/scene.h"
 #include "core/scene_loader.h"
 
 namespace femto::test {
@@ -30,6 +33,32 @@ inline SceneDesc glass_in_fog(const std::string& lights, const std::string& extr
     "lights": [)" + lights + R"(]
   })",
                            "glass in fog", ".");
+}
+
+// Cells (as cells() numbers them) with a pixel whose camera rays meet the sphere (c, r): light
+// tracing cannot connect a vertex to the camera through smooth glass, so it misses what the
+// camera sees through the sphere (docs/outputs.md, "Integrators"); those cells are not compared.
+inline std::vector<bool> cells_seeing_sphere(const Scene& scene, const Vec3& c, double r, int block,
+                                             int group) {
+  const int w = scene.desc().camera.width, h = scene.desc().camera.height;
+  const int bx = (w + block - 1) / block, by = (h + block - 1) / block;
+  const int bt = (scene.desc().time.bins + group - 1) / group;
+  std::vector<bool> skip(static_cast<size_t>(bx * by * bt), false);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      bool sees = false;
+      for (int i = 0; i <= 4; ++i)
+        for (int j = 0; j <= 4; ++j) {
+          const Ray ray = scene.camera().generate_ray(x + 0.25 * i, y + 0.25 * j);
+          const Vec3 oc = c - ray.o;
+          const double along = dot(oc, ray.d);
+          sees = sees || (along > 0 && length_squared(oc - ray.d * along) < r * r);
+        }
+      if (!sees) continue;
+      for (int t = 0; t < bt; ++t)
+        skip[static_cast<size_t>(((y / block) * bx + x / block) * bt + t)] = true;
+    }
+  return skip;
 }
 
 }  // namespace femto::test

@@ -48,6 +48,11 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
   bool specular_since = false;
   // Only diffuse surfaces since a photon's vertex (light -> (S|G)+ -> D D*).
   bool caustic_chain = false;
+  // A delta light's path through non-diffuse surfaces only, the first of them specular
+  // (light -> S (S|G)*): camera paths cannot reach the light from its glossy vertices (a shadow
+  // ray does not pass the S) and photons are stored on diffuse surfaces only. An area light's
+  // such paths stay the camera paths' (they hit the emitter past the S).
+  bool area_light = false, specular_start = false;
   // The current medium ray piece's equiangular sensor connection (sensor_rays_).
   bool ray_active = false;
   Ray ray_piece;
@@ -93,8 +98,13 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
       return true;
     }
     if (indirect_only) {
+      if (v.kind == LightVertex::Kind::Emitter) area_light = true;
       if (v.kind == LightVertex::Kind::Surface) {
         const bool diffuse = v.bsdf->is_diffuse();
+        // That light on a glossy surface the camera sees: light -> S (S|G)* -> G -> sensor.
+        const bool glossy_caustic = specular_start && !diffuse && !v.bsdf->is_delta();
+        specular_start = !area_light && !diffuse &&
+                         (surfaced ? specular_start : v.bsdf->is_delta()) && !scattered;
         // The light's own caustic seen directly, light -> (S|G)+ -> D -> sensor: the photons'
         // prefix, splatted exactly here where the camera sees D without a surface between.
         const bool caustic = diffuse && surfaced && !scattered;
@@ -107,8 +117,9 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
         // diffuse bounces only (light -> (S|G)+ -> D D* -> D -> sensor), which camera paths find
         // only by the directions of their bounces.
         const bool splat_here =
-            caustic || (diffuse && (last == Last::Medium ||
-                                    (last == Last::Diffuse && specular_since) || caustic_chain));
+            caustic || glossy_caustic ||
+            (diffuse &&
+             (last == Last::Medium || (last == Last::Diffuse && specular_since) || caustic_chain));
         caustic_chain = diffuse && (caustic || caustic_chain);
         if (v.bsdf->is_delta()) {
           specular_since = true;
@@ -122,6 +133,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
         const bool after_scattering = scattered || surfaced;
         if (!v.connection_only) {
           scattered = true;
+          specular_start = false;
           last = Last::Medium;
           caustic_chain = false;
           specular_since = false;

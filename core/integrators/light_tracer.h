@@ -27,9 +27,10 @@ class LightTracer {
   /// scattered (off a diffuse surface or in a medium) or met a surface before, light -> X+ -> M
   /// -> sensor, diffuse surface vertices reached from a medium scattering or a diffuse surface
   /// through specular ones, light -> X* M S* -> D and light -> X* D S+ -> D, the light's own
-  /// caustic, light -> (S|G)+ -> D, and what it lights through diffuse bounces alone, light ->
-  /// (S|G)+ -> D D* -> D; the hybrid integrator's camera paths leave exactly those
-  /// paths out (docs/ARCHITECTURE.md, "Path-space partition").
+  /// caustic, light -> (S|G)+ -> D, what it lights through diffuse bounces alone, light ->
+  /// (S|G)+ -> D D* -> D, and a delta light's caustic on a glossy surface, light -> S (S|G)* -> G;
+  /// the hybrid integrator's camera paths leave exactly those paths out (docs/ARCHITECTURE.md,
+  /// "Path-space partition"; the last they cannot reach at all).
   enum class Vertices { All, MediumIndirect };
   LightTracer(const Scene& scene, int max_depth, double t_cut_ps,
               Vertices vertices = Vertices::All);
