@@ -66,6 +66,18 @@ class Camera {
     return true;
   }
 
+  /// Film position (fx, fy) in pixels of a world point in front of the sensor, inside the film
+  /// or not; false behind it.
+  bool raster(const Vec3& x, double& fx, double& fy) const {
+    const bool persp = desc_.type == CameraDesc::Type::Perspective;
+    const Vec3 v = x - desc_.position;
+    const double z = dot(v, forward_);
+    if (!(z > 0)) return false;
+    fx = ((persp ? dot(v, right_) / z : dot(v, right_)) / half_w_ + 1.0) * 0.5 * desc_.width;
+    fy = (1.0 - (persp ? dot(v, up_) / z : dot(v, up_)) / half_h_) * 0.5 * desc_.height;
+    return true;
+  }
+
   /// The part [s0, s1] of the ray o + s d, s in [s0, s1] on entry, that a perspective camera's
   /// film sees (between its four side planes); false if none, or for an orthographic camera.
   bool frustum_interval(const Vec3& o, const Vec3& d, double& s0, double& s1) const {

@@ -55,6 +55,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
   bool area_light = false, specular_start = false;
   // The current medium ray piece's equiangular sensor connection (sensor_rays_).
   bool ray_active = false;
+  int ray_connections = 1;
   Ray ray_piece;
   const bool ball = ball_.active() && indirect_only && sensor_rays_;
   const double r_ball = ball ? ball_.radius : 0.0;
@@ -78,23 +79,38 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
       if (!eq.valid()) return true;
       ray_active = true;
       ray_piece = {v.p, v.d};
-      const double s = eq.sample(rng.uniform());
-      double tau, opl;
-      tracker_.segment_integrals(v.medium, ray_piece, s, tau, opl);
-      const double t_y = v.t_ps + opl / kSpeedOfLight;
-      if (!(t_y <= t_cut_)) return true;  // as the walk, which ends past t_cut
-      const Vec3 y = ray_piece.at(s);
-      const double sigma_t = med.sigma_t_at(y);
-      const double sigma_s = sigma_t * MediumTracker::albedo_at(med, y);
-      double fx, fy, dist, W;
-      Vec3 w;
-      if (!(sigma_s > 0) || !cam.connect_to(y, fx, fy, w, dist, W)) return true;
-      const double T = std::exp(-tau);
-      // Balance heuristic with the collisions: f / (p_eq + sigma_t T).
-      const double p_sum = eq.pdf(s) + sigma_t * T;
-      if (p_sum > 0)
-        splat(y, v.medium, w, dist, v.beta * (sigma_s * T * hg_eval(dot(v.d, w), v.g) * W / p_sum),
-              t_y, v.sigma_ps, fx, fy, out, stats);
+      // A long streak gets several connections: one lands in one pixel, and a thin medium's
+      // light seen across many pixels is otherwise made of sparse dots.
+      ray_connections = 1;
+      double ax, ay, bx, by;
+      if (cam.raster(ray_piece.at(s0), ax, ay) && cam.raster(ray_piece.at(s1), bx, by)) {
+        const double streak = std::hypot(bx - ax, by - ay) / streak_pixels_;
+        if (streak >= 1)
+          ray_connections =
+              streak >= kMaxRayConnections - 1 ? kMaxRayConnections : 1 + static_cast<int>(streak);
+      }
+      const double u = rng.uniform();
+      for (int k = 0; k < ray_connections; ++k) {
+        const double s = eq.sample((k + u) / ray_connections);
+        double tau, opl;
+        tracker_.segment_integrals(v.medium, ray_piece, s, tau, opl);
+        const double t_y = v.t_ps + opl / kSpeedOfLight;
+        if (!(t_y <= t_cut_)) continue;  // as the walk, which ends past t_cut
+        const Vec3 y = ray_piece.at(s);
+        const double sigma_t = med.sigma_t_at(y);
+        const double sigma_s = sigma_t * MediumTracker::albedo_at(med, y);
+        double fx, fy, dist, W;
+        Vec3 w;
+        if (!(sigma_s > 0) || !cam.connect_to(y, fx, fy, w, dist, W)) continue;
+        const double T = std::exp(-tau);
+        // Balance heuristic with the collisions, each of the K points drawn from p_eq:
+        // f / (K p_eq + sigma_t T).
+        const double p_sum = ray_connections * eq.pdf(s) + sigma_t * T;
+        if (p_sum > 0)
+          splat(y, v.medium, w, dist,
+                v.beta * (sigma_s * T * hg_eval(dot(v.d, w), v.g) * W / p_sum), t_y, v.sigma_ps, fx,
+                fy, out, stats);
+      }
       return true;
     }
     if (indirect_only) {
@@ -165,7 +181,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
           double tau, opl;
           tracker_.segment_integrals(v.medium, ray_piece, s, tau, opl);
           const double p_c = media[static_cast<size_t>(v.medium)].sigma_t_at(v.p) * std::exp(-tau);
-          mis = p_c / (p_c + eq.pdf(s));
+          mis = p_c / (p_c + ray_connections * eq.pdf(s));
         }
         splat(v.p, v.medium, w, dist, v.beta * (hg_eval(dot(v.d, w), v.g) * W * mis), v.t_ps,
               v.sigma_ps, fx, fy, out, stats);

@@ -38,6 +38,12 @@ class LightTracer {
   /// paths: they are not splatted, and the ray pieces that pass within ball.reach go to
   /// trace's `ball_beams` instead (core/integrators/camera_ball.h).
   void set_camera_ball(const CameraBall& ball) { ball_ = ball; }
+  /// Pixels of a medium ray's image (its streak on the film) per sensor connection along it:
+  /// a ray whose streak spans L pixels gets min(kMaxRayConnections, 1 + floor(L / px))
+  /// connections, stratified on the equiangular distribution. Large values: one per ray.
+  void set_streak_pixels(double px) { streak_pixels_ = px; }
+  static constexpr double kStreakPixels = 32.0;
+  static constexpr int kMaxRayConnections = 4;
   /// Traces one light path and appends its sensor splats to `out` (and, with a camera ball, the
   /// beams through it to `ball_beams`).
   void trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
@@ -57,9 +63,11 @@ class LightTracer {
   bool unwarp_;
   Vertices vertices_;
   /// Perspective camera: each medium ray piece the splatted vertices may lie on is also connected
-  /// to the sensor at a distance sampled equiangularly towards the pinhole, by MIS with the
-  /// collisions (the splat weighs 1 / dist^2, which collisions alone sample poorly).
+  /// to the sensor at distances sampled equiangularly towards the pinhole (one or more, by the
+  /// length of its streak), by MIS with the collisions (the splat weighs 1 / dist^2, which
+  /// collisions alone sample poorly).
   bool sensor_rays_;
+  double streak_pixels_ = kStreakPixels;
   CameraBall ball_;
 };
 
