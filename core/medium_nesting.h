@@ -19,8 +19,8 @@ void shape_bounds(const ShapeDesc& s, Vec3& lo, Vec3& hi);
 /// For every shape, the index of the innermost medium-bounding shape that strictly encloses it,
 /// or -1 when the global medium surrounds it. Throws InputError, naming both shapes, when the
 /// surfaces of two medium-bounding shapes cross or touch (nesting must be strict).
-/// Shapes that bound no medium and cross a medium boundary get -1: for them the outside
-/// medium only matters on index-matched (material-less) surfaces.
+/// Shapes that bound no medium and cross a medium boundary get -1: paths keep their medium
+/// across them, and a light path's first medium is found past them (medium_at_origin).
 std::vector<int> enclosing_shapes(const SceneDesc& scene);
 
 /// The innermost medium-bounding shape that contains point p (strictly inside), or -1.

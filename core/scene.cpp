@@ -54,10 +54,12 @@ Scene::Scene(SceneDesc desc)
   // shape that bounds no medium has that medium on both sides.
   enclosing_ = enclosing_shapes(desc_);
   outside_of_.assign(n, outside_);
+  bounds_.assign(n, 0);
   for (size_t i = 0; i < n; ++i) {
     const int e = enclosing_[i];
     if (e >= 0) outside_of_[i] = inside_[static_cast<size_t>(e)];
-    if (!bounds_a_medium(desc_.shapes[i])) inside_[i] = outside_of_[i];
+    bounds_[i] = bounds_a_medium(desc_.shapes[i]) ? 1 : 0;
+    if (!bounds_[i]) inside_[i] = outside_of_[i];
   }
   camera_medium_ = medium_at(desc_.camera.position);
   const Vec3 lo = geometry_.bounds_min(), hi = geometry_.bounds_max();

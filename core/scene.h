@@ -30,6 +30,10 @@ class Scene {
   int global_medium() const { return outside_; }
   /// Medium entered when a ray crosses shape i against its normal.
   int inside_medium(int shape) const { return inside_[static_cast<size_t>(shape)]; }
+  /// Whether shape i bounds a medium (a named medium inside, or a refracting surface). Other
+  /// shapes have the same medium on both sides, which outside_medium only names when no medium
+  /// boundary crosses them.
+  bool bounds_medium(int shape) const { return bounds_[static_cast<size_t>(shape)] != 0; }
   /// Medium entered when a ray crosses shape i along its normal: the inside of the innermost
   /// shape around it (media nest), else the global medium.
   int outside_medium(int shape) const { return outside_of_[static_cast<size_t>(shape)]; }
@@ -55,6 +59,7 @@ class Scene {
   std::vector<Medium> media_;
   std::vector<std::unique_ptr<GridMedium>> grids_;
   std::vector<int> inside_;
+  std::vector<char> bounds_;
   std::vector<int> outside_of_;
   std::vector<int> enclosing_;  // enclosing_shapes(desc_)
   int outside_ = 0;

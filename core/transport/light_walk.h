@@ -50,12 +50,21 @@ struct LightVertex {
   bool connection_only = false;
 };
 
-/// Medium a ray starts in: the interior of the first surface it leaves, else the outside.
-inline int medium_at_origin(const Scene& scene, const Ray& ray) {
-  SurfaceHit hit;
-  if (!scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit))
-    return scene.global_medium();
-  return dot(ray.d, hit.ng) > 0 ? scene.inside_medium(hit.shape) : scene.outside_medium(hit.shape);
+/// Medium a ray starts in: the interior of the first medium boundary it leaves, else the
+/// outside of the first it enters, else the global medium. Surfaces that bound no medium are
+/// passed: one may cross a medium's boundary (a mirror standing half in a fog box), so its single
+/// outside medium does not say which side of that boundary the origin is on.
+inline int medium_at_origin(const Scene& scene, Ray ray) {
+  for (int passed = 0; passed < 64; ++passed) {
+    SurfaceHit hit;
+    if (!scene.geometry().intersect(ray, 0.0, std::numeric_limits<double>::infinity(), hit))
+      return scene.global_medium();
+    if (scene.bounds_medium(hit.shape))
+      return dot(ray.d, hit.ng) > 0 ? scene.inside_medium(hit.shape)
+                                    : scene.outside_medium(hit.shape);
+    ray.o = hit.p + ray.d * scene.ray_epsilon();
+  }
+  return scene.medium_at(ray.o);
 }
 
 /// Traces one light sub-path from a light picked by power. `visit(const LightVertex&)` returns
