@@ -88,10 +88,8 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   // pass (docs/ARCHITECTURE.md, "Path-space partition"). With no scattering medium, diffuse
   // surface or glossy surface they would splat nothing.
   const bool glossy_surface =
-      std::any_of(scene.desc().shapes.begin(), scene.desc().shapes.end(), [](const ShapeDesc& sh) {
-        return sh.material.type == MaterialDesc::Type::RoughConductor ||
-               sh.material.type == MaterialDesc::Type::RoughDielectric;
-      });
+      std::any_of(scene.desc().shapes.begin(), scene.desc().shapes.end(),
+                  [](const ShapeDesc& sh) { return sh.material.is_glossy(); });
   const bool light_indirect = hybrid && (caustic_beams || trace_surface_photons || glossy_surface);
   const int64_t indirect_paths = hybrid_light_paths_per_pass(opt, static_cast<int64_t>(W) * H);
   // Photon times include the emission offset: the window end plus the widest pulse spread.

@@ -42,6 +42,8 @@ struct MaterialDesc {
   double roughness = 0.1;        ///< rough dielectric, rough conductor: GGX alpha (0 < alpha <= 1)
   /// Whether the material scatters light into a single direction (a delta BSDF).
   bool is_specular() const { return type == Type::Mirror || type == Type::Dielectric; }
+  /// Whether the material scatters into a lobe around a specular direction (rough, not diffuse).
+  bool is_glossy() const { return type == Type::RoughConductor || type == Type::RoughDielectric; }
   /// Whether light can pass through it into the shape's interior.
   bool is_transmissive() const { return type == Type::Dielectric || type == Type::RoughDielectric; }
 };

@@ -2,42 +2,12 @@
 // crosses a medium's boundary.
 #include <catch2/catch.hpp>
 
-#include <vector>
-
 #include "agreement.h"
 #include "core/scene_loader.h"
+#include "hybrid_scenes.h"
 
 using namespace femto;
 using namespace femto::test;
-
-namespace {
-
-/// Cells (4 x 4 px, `group` bins) with a pixel whose camera rays first meet shape `shape`
-/// (index-matched boundaries passed).
-std::vector<bool> cells_seeing_shape(const Scene& scene, int shape, int group) {
-  const int w = scene.desc().camera.width, h = scene.desc().camera.height;
-  const int bx = (w + 3) / 4, by = (h + 3) / 4, bt = (scene.desc().time.bins + group - 1) / group;
-  std::vector<bool> skip(static_cast<size_t>(bx * by * bt), false);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int i = 0; i <= 4; ++i)
-        for (int j = 0; j <= 4; ++j) {
-          SurfaceHit hit;
-          Ray ray = scene.camera().generate_ray(x + 0.25 * i, y + 0.25 * j);
-          bool found = scene.geometry().intersect(ray, 0.0, 1e30, hit);
-          while (found && scene.desc().shapes[static_cast<size_t>(hit.shape)].material.type ==
-                              MaterialDesc::Type::None) {
-            ray.o = hit.p + ray.d * scene.ray_epsilon();
-            found = scene.geometry().intersect(ray, 0.0, 1e30, hit);
-          }
-          if (!found || hit.shape != shape) continue;
-          for (int t = 0; t < bt; ++t)
-            skip[static_cast<size_t>(((y / 4) * bx + x / 4) * bt + t)] = true;
-        }
-  return skip;
-}
-
-}  // namespace
 
 // Catches: light paths taking their first medium from the first surface in their way when that
 // surface bounds no medium. The mirror stands in the fog box and out of its top, so no medium
