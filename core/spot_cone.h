@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/lights.h"
+#include "core/narrow_interval.h"
 #include "core/vec3.h"
 
 namespace femto {
@@ -45,12 +46,7 @@ inline bool spot_cone_interval(const Light& l, const Ray& ray, double& lo, doubl
     s0 = lo;
     s1 = r1;
   }
-  const double pad = 1e-9 * (std::abs(s0) + std::abs(s1) + (hi - lo));
-  const double n0 = std::max(lo, s0 - pad), n1 = std::min(hi, s1 + pad);
-  if (!(n1 > n0)) return false;
-  lo = n0;
-  hi = n1;
-  return true;
+  return narrow_interval(s0, s1, (hi - lo), lo, hi);
 }
 
 }  // namespace femto

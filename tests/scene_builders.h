@@ -63,6 +63,17 @@ inline MediumDesc medium(const char* name, double sigma_a, double sigma_s, doubl
   return m;
 }
 
+/// A laser at the origin along +x: radius R (mm), power P.
+inline LightDesc laser_along_x(double R, double P) {
+  LightDesc l;
+  l.type = LightDesc::Type::Laser;
+  l.position = {0, 0, 0};
+  l.direction = {1, 0, 0};
+  l.radius = R;
+  l.power = RGB(P);
+  return l;
+}
+
 /// Renders `desc` once per seed (seeds base..base+batches-1) and returns each batch's film.
 inline std::vector<TransientFilm> render_batches(const SceneDesc& desc, int spp, int batches,
                                                  int max_depth = 1000, int threads = 2) {

@@ -20,6 +20,7 @@
 #include "media/phase_hg.h"
 #include "samplers/distance.h"
 #include "samplers/exponential_ziggurat.h"
+#include "samplers/interval_exponential.h"
 #include "samplers/stats.h"
 
 using femto::kPi;
@@ -234,6 +235,53 @@ TEST_CASE("Exponential distance sampling matches exponential_pdf", "[samplers][d
                       << "  p = " << r.p_value);
     CHECK(r.p_value >= kSamplerAlpha);
   }
+}
+
+// Catches a wrong inverse CDF in IntervalExponential (a missing offset a, the untruncated
+// exponential, log(u) for log(1 - u mass)), a pdf that is not its density (a missing
+// normalisation 1 - exp(-lambda L)), and a broken uniform limit or infinite interval.
+TEST_CASE("Interval exponential sampling matches its pdf", "[samplers][distance]") {
+  struct Case {
+    double a, b, lambda;
+  };
+  uint64_t seed = 31;
+  for (const Case c :
+       {Case{2.0, 5.0, 0.7}, Case{-1.0, 0.5, 12.0}, Case{3.0, 4.0, 0.0}, Case{0.0, 1.0, 1e-10},
+        Case{1.0, std::numeric_limits<double>::infinity(), 2.0}}) {
+    const femto::IntervalExponential sampler(c.a, c.b, c.lambda);
+    REQUIRE(sampler.valid());
+    const int bins = 40, n = 200000;
+    const double hi = std::isfinite(c.b) ? c.b : c.a + 8.0 / c.lambda, h = (hi - c.a) / bins;
+    std::vector<double> observed(bins + 1, 0.0), expected(bins + 1, 0.0);
+    Rng rng(seed++, 5);
+    int outside = 0;
+    for (int k = 0; k < n; ++k) {
+      const double s = sampler.sample(rng.uniform());
+      if (!(s >= c.a && s <= c.b)) {
+        ++outside;
+        continue;
+      }
+      observed[s >= hi ? bins : std::min(bins - 1, static_cast<int>((s - c.a) / h))] += 1.0;
+    }
+    CHECK(outside == 0);
+    const auto pdf = [&](double s) { return sampler.pdf(s); };
+    double mass = 0.0;
+    for (int i = 0; i < bins; ++i) {
+      const double m = st::adaptive_simpson(pdf, c.a + i * h, c.a + (i + 1) * h, 1e-12);
+      expected[i] = n * m;
+      mass += m;
+    }
+    const double tail = std::isfinite(c.b) ? 0.0 : integrate_to_infinity(pdf, hi, c.lambda);
+    expected[bins] = n * tail;
+    CHECK(mass + tail == Approx(1.0).margin(1e-9));
+    const st::Chi2Result r = st::chi2_test(observed, expected);
+    INFO("a = " << c.a << " b = " << c.b << " lambda = " << c.lambda << "  chi2 = " << r.chi2
+                << "  dof = " << r.dof << "  p = " << r.p_value);
+    CHECK(r.p_value >= kSamplerAlpha);
+  }
+  CHECK_FALSE(femto::IntervalExponential(1.0, 1.0, 1.0).valid());
+  CHECK_FALSE(
+      femto::IntervalExponential(0.0, std::numeric_limits<double>::infinity(), 0.0).valid());
 }
 
 // Catches a wrong ziggurat table (a layer whose area is not the others', edges that do not reach

@@ -58,13 +58,7 @@ TEST_CASE("laser beam single scattering seen from the side", "[tracer][analytic]
   d.time.bins = 20;
   d.media.push_back(medium("m", sigma_a, sigma_s, g, eta));
   d.global_medium = 0;
-  LightDesc l;
-  l.type = LightDesc::Type::Laser;
-  l.position = {0, 0, 0};
-  l.direction = {1, 0, 0};
-  l.radius = R;
-  l.power = RGB(P);
-  d.lights.push_back(l);
+  d.lights.push_back(laser_along_x(R, P));
   const auto films = render_batches(d, 20000, 16, /*max_depth=*/1);
   const double st = sigma_a + sigma_s, E = P / (kPi * R * R), half = std::sqrt(R * R - y0 * y0);
   double total_mc = 0;

@@ -67,11 +67,17 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
       // collision density sigma_t T is the other strategy of the MIS).
       ray_active = false;
       const Medium& med = media[static_cast<size_t>(v.medium)];
-      if (indirect_only && !scattered && !surfaced) return true;
+      // Direct light is the camera paths', but for a laser's beam (light -> M -> sensor), which
+      // they find only where a point of the beam is on their segment.
+      if (indirect_only && !scattered && !surfaced && !v.collimated) return true;
       // Up to the surface and the time cut-off (eta >= 1: time >= distance / c).
       double s0 = 0.0, s1 = std::fmin(v.length, (t_cut_ - v.t_ps) * kSpeedOfLight);
       Beam beam;
-      if (ball && ball_beams && s1 > 0 && camera_ball_beam(tracker_, ball_, v, s1, beam))
+      // A laser's own beam (the flags are kept for the hybrid's share only). Inside the ball it
+      // is the camera paths' (laser chords, exact there).
+      const bool laser_beam = indirect_only && v.collimated && !scattered && !surfaced;
+      if (ball && ball_beams && s1 > 0 && !laser_beam &&
+          camera_ball_beam(tracker_, ball_, v, s1, beam))
         ball_beams->push_back(beam);
       if (med.strategy.kind != DistanceSampling::Mfp) return true;
       if (!(s1 > 0) || !cam.frustum_interval(v.p, v.d, s0, s1)) return true;
@@ -81,9 +87,12 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
       ray_piece = {v.p, v.d};
       // A long streak gets several connections: one lands in one pixel, and a thin medium's
       // light seen across many pixels is otherwise made of sparse dots.
+      // Not on a laser's own beam: every light path has (nearly) the same one, so one each
+      // already covers its streak densely.
       ray_connections = 1;
       double ax, ay, bx, by;
-      if (cam.raster(ray_piece.at(s0), ax, ay) && cam.raster(ray_piece.at(s1), bx, by)) {
+      if (!laser_beam && cam.raster(ray_piece.at(s0), ax, ay) &&
+          cam.raster(ray_piece.at(s1), bx, by)) {
         const double streak = std::hypot(bx - ax, by - ay) / streak_pixels_;
         if (streak >= 1)
           ray_connections =
@@ -124,6 +133,9 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
         // The light's own caustic seen directly, light -> (S|G)+ -> D -> sensor: the photons'
         // prefix, splatted exactly here where the camera sees D without a surface between.
         const bool caustic = diffuse && surfaced && !scattered;
+        // A laser's spot on the surface the camera sees (light -> D|G -> sensor): camera paths
+        // find it only where a pixel sample lands in it.
+        const bool laser_spot = v.collimated && !surfaced && !scattered && !v.bsdf->is_delta();
         surfaced = true;
         scattered = scattered || diffuse;
         // Light scattered in a medium onto a diffuse surface, straight or through specular
@@ -133,7 +145,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
         // diffuse bounces only (light -> (S|G)+ -> D D* -> D -> sensor), which camera paths find
         // only by the directions of their bounces.
         const bool splat_here =
-            caustic || glossy_caustic ||
+            caustic || glossy_caustic || laser_spot ||
             (diffuse &&
              (last == Last::Medium || (last == Last::Diffuse && specular_since) || caustic_chain));
         caustic_chain = diffuse && (caustic || caustic_chain);
@@ -154,8 +166,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
           caustic_chain = false;
           specular_since = false;
         }
-        // Direct light (light -> M) is the camera paths' share.
-        if (!after_scattering) return true;
+        // Direct light (light -> M) is the camera paths' share, but a laser's.
+        if (!after_scattering && !v.collimated) return true;
       }
     }
     double fx, fy, dist, W;

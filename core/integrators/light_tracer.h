@@ -28,7 +28,8 @@ class LightTracer {
   /// -> sensor, diffuse surface vertices reached from a medium scattering or a diffuse surface
   /// through specular ones, light -> X* M S* -> D and light -> X* D S+ -> D, the light's own
   /// caustic, light -> (S|G)+ -> D, what it lights through diffuse bounces alone, light ->
-  /// (S|G)+ -> D D* -> D, and a delta light's caustic on a glossy surface, light -> S (S|G)* -> G;
+  /// (S|G)+ -> D D* -> D, a delta light's caustic on a glossy surface, light -> S (S|G)* -> G,
+  /// and a laser's beam and spots, laser -> M and laser -> D|G;
   /// the hybrid integrator's camera paths leave exactly those paths out (docs/ARCHITECTURE.md,
   /// "Path-space partition"; the last they cannot reach at all).
   enum class Vertices { All, MediumIndirect };

@@ -102,6 +102,8 @@ VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& f
       total += lights.pmf(i);
     }
   for (double& p : point_pmf_) p /= total;
+  for (int i = 0; i < lights.count(); ++i)
+    if (lights.light(i).type == Light::Type::Laser) lasers_.push_back(i);
   std::vector<Vec3> lo, hi;
   medium_bounds(scene, lo, hi);
   thin_media_ = thin_media_lit_from_outside(scene, point_lights_, lo, hi);
@@ -182,6 +184,7 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
   if (li < 0 || beta.is_black()) return;
   const Light& L = lights.light(li);
   double w_seg = 1.0;  // the collisions' balance-heuristic weight on a time_mis segment
+  if (L.type == Light::Type::Laser) return;  // estimate_laser_chords' share
   if (is_point_like(L)) {
     if (segment.covers(L)) return;  // estimate_segment's share
     if (s_seg >= 0 && segment.mis_with_collisions(L)) {
@@ -208,13 +211,14 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
 
 void VolPathIntegrator::estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit,
                                                 const Frame& frame, const Vec3& wo, bool wo_outside,
-                                                int m_wo, const RGB& beta, double t, Rng& rng,
-                                                PixelAccumulator& acc, PathStats& stats) const {
+                                                int m_wo, const RGB& beta, double t, bool lasers,
+                                                Rng& rng, PixelAccumulator& acc,
+                                                PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
   const double u1 = rng.uniform(), u2 = rng.uniform();
-  if (li < 0) return;
+  if (li < 0 || (!lasers && lights.light(li).type == Light::Type::Laser)) return;
   const double eps = scene_.ray_epsilon();
   // Probe point for the light sample: the side of wo; a transmitted sample leaves from the other
   // side.
@@ -324,6 +328,17 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       plan_segment(med, m, ray, s_surf, t, t_dropped, on_camera_segment, segment);
       if ((segment.active || segment.time_mis) && medium_light)
         estimate_segment(med, m, segment, beta, rng, acc, stats);
+      // On the camera's own segment a laser's beam is light tracing's (light_indirect), but
+      // inside the camera ball, where chords are exact and light tracing would need the ball's
+      // kernel.
+      if (!lasers_.empty() && medium_light && med.interacts()) {
+        const bool ball = null_crossings == 0 && beams && beams->ball;
+        const double s_chords = !(light_indirect && on_camera_segment) ? s_surf
+                                : ball ? std::fmin(s_surf, beams->ball_radius)
+                                       : 0.0;
+        if (s_chords > 0)
+          estimate_laser_chords(med, m, ray, s_chords, t, t_dropped, beta, rng, acc, stats);
+      }
       // Angular direction sampling: the next segment's distance draw is made now so that every
       // strategy's MIS weight at this segment's vertices sees the same r_aux.
       const bool angular = med.direction == DirectionSampling::Angular && !point_lights_.empty() &&
@@ -422,7 +437,9 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       photons->gather(bsdf, hit, frame, wo, beta, t, acc, stats);
     // Next-event estimation, except where a photon owns the path (light -> glossy -> diffuse).
     if (!bsdf.is_delta() && !(!bsdf.is_diffuse() && owned(last)))
-      estimate_direct_surface(bsdf, hit, frame, wo, wo_outside, m, beta, t, rng, acc, stats);
+      // A laser's spot on the surface the camera sees is light tracing's (light_indirect).
+      estimate_direct_surface(bsdf, hit, frame, wo, wo_outside, m, beta, t,
+                              !(light_indirect && first_vertex), rng, acc, stats);
     if (bsdf.is_diffuse()) {
       last = Last::Diffuse;
       since = 0;

@@ -36,9 +36,10 @@ class VolPathIntegrator {
   /// path's first vertex is a medium vertex x_c, only light arriving there directly (next-event
   /// estimation, emission hit) comes from this path: light that scattered or passed a surface
   /// before reaching x_c comes from light tracing (LightTracer::Vertices::MediumIndirect), and
-  /// no caustic beams are gathered on the camera's own segment. When x_c is a diffuse surface,
-  /// light tracing gives the light reaching it from a medium scattering (on the segments leaving
-  /// x_c through specular surfaces this path takes no medium light), from a diffuse surface
+  /// no caustic beams are gathered on the camera's own segment; a laser's light there (its beam)
+  /// and at a first surface vertex (its spot) is light tracing's too. When x_c is a diffuse
+  /// surface, light tracing gives the light reaching it from a medium scattering (on the segments
+  /// leaving x_c through specular surfaces this path takes no medium light), from a diffuse surface
   /// through specular ones, and from the light through non-diffuse surfaces only (no photons
   /// are gathered at x_c).
   void trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStats& stats,
@@ -132,10 +133,15 @@ class VolPathIntegrator {
   /// line-to-point with the collisions by MIS).
   void estimate_segment(const Medium& med, int m, const ConnectedSegment& segment, const RGB& beta,
                         Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
+  /// Direct light from every laser scattered anywhere on [0, s_surf) of the segment's ray in
+  /// medium m: one point on the stretch inside each beam (core/laser_cylinder.h), drawn with the
+  /// decay of both transmittances along it (core/integrators/laser_chords.cpp). Collision
+  /// next-event estimation leaves lasers to it.
+  void estimate_laser_chords(const Medium& med, int m, const Ray& ray, double s_surf, double t,
+                             double t_factor, const RGB& beta, Rng& rng, PixelAccumulator& acc,
+                             PathStats& stats) const;
   void deposit(double t_ps, double sigma_ps, const RGB& value, PixelAccumulator& acc,
                PathStats& stats) const;
-  /// Next-event estimation at a surface vertex with a non-delta BSDF (local frame z = ng); m_wo
-  /// is the medium on the side of wo (the path's).
   /// Russian roulette after the vertex at `depth`: false ends the path; a survivor's beta is
   /// divided by its probability.
   bool survives_roulette(int depth, RGB& beta, Rng& rng, PathStats& stats) const {
@@ -149,9 +155,13 @@ class VolPathIntegrator {
     beta *= 1.0 / q;
     return true;
   }
+  /// Next-event estimation at a surface vertex with a non-delta BSDF (local frame z = ng); m_wo
+  /// is the medium on the side of wo (the path's). Without `lasers` a laser picked gives nothing
+  /// (light tracing's share).
   void estimate_direct_surface(const Bsdf& bsdf, const SurfaceHit& hit, const Frame& frame,
                                const Vec3& wo, bool wo_outside, int m_wo, const RGB& beta, double t,
-                               Rng& rng, PixelAccumulator& acc, PathStats& stats) const;
+                               bool lasers, Rng& rng, PixelAccumulator& acc,
+                               PathStats& stats) const;
 
   const Scene& scene_;
   MediumTracker tracker_;
@@ -167,6 +177,7 @@ class VolPathIntegrator {
   /// (media_far_from_lights), so plan_segment skips the rules where no other one applies.
   std::vector<char> far_media_;
   std::vector<double> point_pmf_;  ///< their pick probabilities, proportional to power
+  std::vector<int> lasers_;        ///< lasers: targets of laser chords
 };
 
 }  // namespace femto

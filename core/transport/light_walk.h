@@ -48,6 +48,8 @@ struct LightVertex {
   /// A medium vertex for connections only (the time-uniform collision of MIS distance sampling):
   /// the path does not continue from it.
   bool connection_only = false;
+  /// The path's light is a laser (its first medium rays are the beam itself).
+  bool collimated = false;
 };
 
 /// Medium a ray starts in: the interior of the first medium boundary it leaves, else the
@@ -97,6 +99,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
     return;
 
   LightVertex v;
+  const bool collimated = L.type == Light::Type::Laser;
   v.t_ps = L.pulse.offset_ps;
   v.sigma_ps = L.pulse.sigma_ps();
   Ray ray = e.ray;
@@ -132,6 +135,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
       piece.t_ps = t;
       piece.sigma_ps = v.sigma_ps;
       piece.chain = chain;
+      piece.collimated = collimated;
       piece.length = length;
       visit(static_cast<const LightVertex&>(piece));
     };
@@ -159,6 +163,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
       c.sigma_ps = v.sigma_ps;
       c.chain = -1;
       c.connection_only = true;
+      c.collimated = collimated;
       visit(static_cast<const LightVertex&>(c));
     }
     const DistanceEvent& ev = ms.main;
@@ -188,6 +193,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
       v.t_ps = t;
       v.sigma_ps = L.pulse.sigma_ps();
       v.chain = chain;
+      v.collimated = collimated;
       if (!visit(static_cast<const LightVertex&>(v))) return;
       const double u_phi = rng.uniform();  // the azimuth's first (a stated order, as GCC had it)
       const double u_cos = rng.uniform();
@@ -226,6 +232,7 @@ void walk_light_path(const Scene& scene, const MediumTracker& tracker, Rng& rng,
     v.t_ps = t;
     v.sigma_ps = L.pulse.sigma_ps();
     v.chain = chain;
+    v.collimated = collimated;
     if (!visit(static_cast<const LightVertex&>(v))) return;
     chain = bsdf.is_diffuse() || chain < 0 ? -1 : chain + 1;
     BsdfSample bs;
