@@ -3,8 +3,9 @@
 
 Each configuration renders the scene once per seed (seeds 100, 101, ...; the configurations
 interleaved seed by seed, so a noisy host slows them alike) on one thread. A pixel's steady value
-is the sum of its time bins (mean of the channels); its variance across the seeds times the
-configuration's mean render time is its variance per unit time (lower is better). Pixels are
+is the sum of its time bins (of bins FIRST to END - 1 only with --bins FIRST:END; mean of the
+channels); its variance across the seeds times the configuration's mean render time is its
+variance per unit time (lower is better). Pixels are
 classed by the mean image of the configurations named in --mask-from: "bright" above 10% of its
 peak, "dim" from 0.3% to 10%, "lit" above 0.3%. For each class: the summed variance x time (what
 a crop's RMSE measures) and the median over its pixels, then the same over lit pixel-bins of the
@@ -34,6 +35,7 @@ def main():
                     help="NAME:FEMTO_BINARY:ARGS (ARGS split on spaces)")
     ap.add_argument("--mask-from", default="", help="comma-separated names (default: all)")
     ap.add_argument("--base", default="", help="the configuration ratios are against (default: first)")
+    ap.add_argument("--bins", default="", help="FIRST:END, only these time bins (e.g. late light)")
     a = ap.parse_args()
     configs = [c.split(":", 2) for c in a.config]
     names = [c[0] for c in configs]
@@ -49,8 +51,13 @@ def main():
                                check=True)
                 seconds[name] += time.monotonic() - start
                 # (H, W, bins, 3) -> (H, W, bins), channels averaged
-                films[name].append(np.load(os.path.join(out, "transient.npy")).mean(axis=-1))
-    print(f"{cpu_model()}; {a.scene}, {a.seeds} seeds, one thread")
+                film = np.load(os.path.join(out, "transient.npy")).mean(axis=-1)
+                if a.bins:
+                    first, end = (int(x) for x in a.bins.split(":"))
+                    film = film[:, :, first:end]
+                films[name].append(film)
+    print(f"{cpu_model()}; {a.scene}, {a.seeds} seeds, one thread"
+          + (f", bins {a.bins}" if a.bins else ""))
     mask_names = a.mask_from.split(",") if a.mask_from else names
     mean_img = np.mean([np.mean(films[n], axis=0).sum(axis=-1) for n in mask_names], axis=0)
     peak = mean_img.max()

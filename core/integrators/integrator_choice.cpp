@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/constants.h"
+#include "core/medium_nesting.h"
 #include "core/render.h"
 
 namespace femto {
@@ -25,10 +26,23 @@ const char* integrator_name(IntegratorKind kind) {
   return "?";
 }
 
+namespace {
+bool scatters(const MediumDesc& m) {
+  return m.type == MediumDesc::Type::Vdb || m.medium.sigma_s > 0;
+}
+
+// The medium around the camera scatters: light tracing alone would splat points next to the
+// pinhole with weight 1 / d^2 (the hybrid's camera ball takes them instead).
+bool camera_in_scattering_medium(const SceneDesc& scene) {
+  const int shape = innermost_shape_at(scene, enclosing_shapes(scene), scene.camera.position);
+  const int m =
+      shape >= 0 ? scene.shapes[static_cast<size_t>(shape)].interior_medium : scene.global_medium;
+  return m >= 0 && scatters(scene.media[static_cast<size_t>(m)]);
+}
+}  // namespace
+
 bool has_scattering_medium(const SceneDesc& scene) {
-  return std::any_of(scene.media.begin(), scene.media.end(), [](const MediumDesc& m) {
-    return m.type == MediumDesc::Type::Vdb || m.medium.sigma_s > 0;
-  });
+  return std::any_of(scene.media.begin(), scene.media.end(), scatters);
 }
 
 IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, std::string& why) {
@@ -42,32 +56,27 @@ IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, s
         return s.material.type != MaterialDesc::Type::None &&
                s.material.type != MaterialDesc::Type::Diffuse;
       });
-  // A laser lights only its beam: camera paths reach it by segment connections (laser chords)
-  // but the light scattered off the beam, and its spots, only by chance.
-  const bool laser_in_medium =
-      has_scattering_medium(scene) &&
+  // A laser lights only its beam and its spots: camera paths reach the beam by segment connections
+  // (laser chords), but the light scattered off it, and what a spot lights, only by chance (a
+  // relay wall's spot in a non-line-of-sight scene: never).
+  const bool scattering = has_scattering_medium(scene);
+  const bool laser_lights =
       std::any_of(scene.lights.begin(), scene.lights.end(),
-                  [](const LightDesc& l) { return l.type == LightDesc::Type::Laser; });
-  if (!delta_light || (!non_diffuse && !laser_in_medium)) {
+                  [](const LightDesc& l) { return l.type == LightDesc::Type::Laser; }) &&
+      (scattering || std::any_of(scene.shapes.begin(), scene.shapes.end(), [](const ShapeDesc& s) {
+         return s.material.type == MaterialDesc::Type::Diffuse;
+       }));
+  if (!delta_light || (!non_diffuse && !laser_lights)) {
     why =
         "auto: no caustics to gather (needs a point, spot or laser light and a non-diffuse "
-        "surface, or a laser in a scattering medium)";
+        "surface, or a laser lighting a diffuse surface or a scattering medium)";
     return IntegratorKind::Path;
   }
   if (scene.reconstruction.type == TemporalFilter::Kind::Kernel) {
     why =
-        "auto: the scene has caustics or a laser in a medium, but the kernel film works with "
-        "camera paths only";
+        "auto: the scene has caustics or a laser, but the kernel film works with camera paths "
+        "only";
     return IntegratorKind::Path;
-  }
-  if (!has_scattering_medium(scene)) {
-    // Light tracing gives the caustic seen directly exactly, photons the rest: 6x (steady) and
-    // 129x (transient) lower error than photons alone at equal time on a floor caustic seen
-    // directly (docs/PERFORMANCE.md, "Without fog"; what is seen through glass not measured).
-    why =
-        "auto: delta lights and non-diffuse surfaces, so caustics come from light tracing where "
-        "the camera sees them directly and from photons elsewhere";
-    return IntegratorKind::Hybrid;
   }
   // Every surface specular (glass, mirrors, index-matched boundaries): no photon has a surface to
   // land on, and camera paths meet the media before any non-specular surface, so beams gather
@@ -78,20 +87,38 @@ IntegratorKind resolve_integrator(const SceneDesc& scene, IntegratorKind kind, s
       std::all_of(scene.shapes.begin(), scene.shapes.end(), [](const ShapeDesc& s) {
         return s.material.type == MaterialDesc::Type::None || s.material.is_specular();
       });
+  if (!non_diffuse && !(scattering && all_specular)) {
+    // Light tracing reaches everything here (no specular surface hides what the camera sees) and
+    // finds the beam, its spots and what they light where camera paths find them by chance:
+    // 1.4x lower summed variance per unit time than the hybrid on a 0.5 mm beam in fog and 5x
+    // in a non-line-of-sight scene (docs/PERFORMANCE.md, "Lasers in fog").
+    if (!camera_in_scattering_medium(scene)) {
+      why =
+          "auto: a laser lighting diffuse surfaces or a scattering medium, and no specular "
+          "surface, so light tracing finds all light";
+      return IntegratorKind::Light;
+    }
+    // With the camera in the fog the hybrid keeps the points next to the pinhole for camera
+    // paths (the camera ball).
+    why =
+        "auto: a laser lighting a scattering medium around the camera, so light tracing gives its "
+        "beam, its spots and the light they throw, camera paths the light next to the camera";
+    return IntegratorKind::Hybrid;
+  }
+  if (!scattering) {
+    // Light tracing gives the caustic seen directly exactly, photons the rest: 6x (steady) and
+    // 129x (transient) lower error than photons alone at equal time on a floor caustic seen
+    // directly (docs/PERFORMANCE.md, "Without fog"; what is seen through glass not measured).
+    why =
+        "auto: delta lights and non-diffuse surfaces, so caustics come from light tracing where "
+        "the camera sees them directly and from photons elsewhere";
+    return IntegratorKind::Hybrid;
+  }
   if (all_specular) {
     why =
         "auto: delta lights and a scattering medium behind specular surfaces only, so photon "
         "beams gather all light scattered in the media";
     return IntegratorKind::Beams;
-  }
-  if (!non_diffuse) {
-    // Light tracing takes the beam seen directly, its spots on the surfaces the camera sees and
-    // the light scattered off it (300x lower summed variance per unit time than camera paths alone
-    // on a 0.5 mm beam in fog, docs/PERFORMANCE.md, "Lasers in fog").
-    why =
-        "auto: a laser in a scattering medium, so light tracing gives its beam, its spots and "
-        "the light scattered off them, camera paths the rest";
-    return IntegratorKind::Hybrid;
   }
   why =
       "auto: delta lights, non-diffuse surfaces and a scattering medium, so caustics come from "

@@ -48,6 +48,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
   bool specular_since = false;
   // Only diffuse surfaces since a photon's vertex (light -> (S|G)+ -> D D*).
   bool caustic_chain = false;
+  // Only diffuse surfaces since a laser's spot (laser -> D|G -> D*), no medium scattering.
+  bool laser_chain = false;
   // A delta light's path through non-diffuse surfaces only, the first of them specular
   // (light -> S (S|G)*): camera paths cannot reach the light from its glossy vertices (a shadow
   // ray does not pass the S) and photons are stored on diffuse surfaces only. An area light's
@@ -133,9 +135,12 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
         // The light's own caustic seen directly, light -> (S|G)+ -> D -> sensor: the photons'
         // prefix, splatted exactly here where the camera sees D without a surface between.
         const bool caustic = diffuse && surfaced && !scattered;
-        // A laser's spot on the surface the camera sees (light -> D|G -> sensor): camera paths
-        // find it only where a pixel sample lands in it.
+        // A laser's spot on the surface the camera sees (laser -> D|G -> sensor), and what it
+        // lights through diffuse bounces alone (laser -> D|G -> D+ -> sensor): camera paths find
+        // the spot only where a pixel sample lands in it, or a bounce hits it.
         const bool laser_spot = v.collimated && !surfaced && !scattered && !v.bsdf->is_delta();
+        const bool laser_lit = laser_spot || (laser_chain && diffuse);
+        laser_chain = laser_lit;
         surfaced = true;
         scattered = scattered || diffuse;
         // Light scattered in a medium onto a diffuse surface, straight or through specular
@@ -145,7 +150,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
         // diffuse bounces only (light -> (S|G)+ -> D D* -> D -> sensor), which camera paths find
         // only by the directions of their bounces.
         const bool splat_here =
-            caustic || glossy_caustic || laser_spot ||
+            caustic || glossy_caustic || laser_lit ||
             (diffuse &&
              (last == Last::Medium || (last == Last::Diffuse && specular_since) || caustic_chain));
         caustic_chain = diffuse && (caustic || caustic_chain);
@@ -164,6 +169,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
           specular_start = false;
           last = Last::Medium;
           caustic_chain = false;
+          laser_chain = false;
           specular_since = false;
         }
         // Direct light (light -> M) is the camera paths' share, but a laser's.

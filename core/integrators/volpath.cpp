@@ -437,9 +437,11 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
       photons->gather(bsdf, hit, frame, wo, beta, t, acc, stats);
     // Next-event estimation, except where a photon owns the path (light -> glossy -> diffuse).
     if (!bsdf.is_delta() && !(!bsdf.is_diffuse() && owned(last)))
-      // A laser's spot on the surface the camera sees is light tracing's (light_indirect).
+      // A laser's spot on the surface the camera sees, and on those lighting it through diffuse
+      // bounces alone, is light tracing's (light_indirect).
       estimate_direct_surface(bsdf, hit, frame, wo, wo_outside, m, beta, t,
-                              !(light_indirect && first_vertex), rng, acc, stats);
+                              !(light_indirect && (first_vertex || diffuse_chain)), rng, acc,
+                              stats);
     if (bsdf.is_diffuse()) {
       last = Last::Diffuse;
       since = 0;
