@@ -50,6 +50,8 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
   bool caustic_chain = false;
   // Only diffuse surfaces since a laser's spot (laser -> D|G -> D*), no medium scattering.
   bool laser_chain = false;
+  // Nothing but straight pieces so far (every light path of a laser shares its beam's).
+  bool first_rays = true;
   // A delta light's path through non-diffuse surfaces only, the first of them specular
   // (light -> S (S|G)*): camera paths cannot reach the light from its glossy vertices (a shadow
   // ray does not pass the S) and photons are stored on diffuse surfaces only. An area light's
@@ -75,9 +77,9 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
       // Up to the surface and the time cut-off (eta >= 1: time >= distance / c).
       double s0 = 0.0, s1 = std::fmin(v.length, (t_cut_ - v.t_ps) * kSpeedOfLight);
       Beam beam;
-      // A laser's own beam (the flags are kept for the hybrid's share only). Inside the ball it
-      // is the camera paths' (laser chords, exact there).
-      const bool laser_beam = indirect_only && v.collimated && !scattered && !surfaced;
+      // A laser's own beam. Inside the camera ball it is the camera paths' (laser chords, exact
+      // there).
+      const bool laser_beam = v.collimated && first_rays;
       if (ball && ball_beams && s1 > 0 && !laser_beam &&
           camera_ball_beam(tracker_, ball_, v, s1, beam))
         ball_beams->push_back(beam);
@@ -124,6 +126,7 @@ void LightTracer::trace(Rng& rng, std::vector<Splat>& out, PathStats& stats,
       }
       return true;
     }
+    first_rays = first_rays && (v.kind == LightVertex::Kind::Segment || v.connection_only);
     if (indirect_only) {
       if (v.kind == LightVertex::Kind::Emitter) area_light = true;
       if (v.kind == LightVertex::Kind::Surface) {
