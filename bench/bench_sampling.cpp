@@ -140,6 +140,7 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
       {"mfp + line_to_point", DistanceSampling::Mfp, ConnectionSampling::LineToPoint, false},
       {"mfp + mis", DistanceSampling::Mfp, ConnectionSampling::Mis, false},
       {"mis + collision", DistanceSampling::Mis, ConnectionSampling::Collision, false},
+      {"mis + auto", DistanceSampling::Mis, ConnectionSampling::Auto, false},
       {"time_uniform + collision", DistanceSampling::TimeUniform, ConnectionSampling::Collision,
        false},
       {"mixture + collision", DistanceSampling::Mixture, ConnectionSampling::Collision, false},
