@@ -11,6 +11,7 @@
 #include "core/distributed/bytes.h"
 #include "core/distributed/render_gather.h"
 #include "core/integrators/light_tracer.h"
+#include "core/integrators/splat_deposit.h"
 #include "core/progress.h"
 #include "core/render.h"
 #include "core/render_passes.h"
@@ -50,8 +51,7 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
   const size_t stride = static_cast<size_t>(state.stride);
   const size_t nb = static_cast<size_t>(axis.bins) * 3;
   std::vector<std::vector<Splat>> per_chunk(static_cast<size_t>(std::min(chunks, kChunksPerBatch)));
-  std::vector<uint32_t> offsets(pixels + 1);
-  std::vector<const Splat*> sorted;
+  SplatScratch scratch;
 
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
   // Across ranks, chunk c is traced by rank c % ranks; after each batch, rank 0 receives the
@@ -102,39 +102,11 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
           continue;
         }
       }
-      // Bin the batch: a stable counting sort by pixel keeps path order within each pixel, so
-      // every pixel sums its splats in the same order whatever the thread count.
-      std::fill(offsets.begin(), offsets.end(), 0u);
-      size_t n = 0;
-      for (int64_t c = c0; c < c1; ++c)
-        for (const Splat& s : per_chunk[static_cast<size_t>(c - c0)]) {
-          ++offsets[s.pixel + 1];
-          ++n;
-        }
-      for (size_t p = 0; p < pixels; ++p) offsets[p + 1] += offsets[p];
-      sorted.resize(n);
-      {
-        std::vector<uint32_t> next(offsets.begin(), offsets.end() - 1);
-        for (int64_t c = c0; c < c1; ++c)
-          for (const Splat& s : per_chunk[static_cast<size_t>(c - c0)])
-            sorted[next[s.pixel]++] = &s;
-      }
-      tbb::parallel_for(
-          tbb::blocked_range<size_t>(0, pixels, 256), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t p = r.begin(); p != r.end(); ++p) {
-              if (offsets[p] == offsets[p + 1]) continue;
-              double* px = state.sums.data() + p * stride;
-              RGB before = passes::load_rgb(px + nb), after = passes::load_rgb(px + nb + 3);
-              for (uint32_t k = offsets[p]; k < offsets[p + 1]; ++k) {
-                const Splat& s = *sorted[k];
-                const DepositSplit split = filter.deposit(s.t_ps, s.sigma_ps, s.value, px);
-                if (split.before > 0) before += s.value * split.before;
-                if (split.after > 0) after += s.value * split.after;
-              }
-              passes::store_rgb(px + nb, before);
-              passes::store_rgb(px + nb + 3, after);
-            }
-          });
+      // Bin the batch: every pixel sums its splats in path order whatever the thread count.
+      deposit_splats(
+          static_cast<size_t>(c1 - c0),
+          [&](size_t c) -> const std::vector<Splat>& { return per_chunk[c]; }, 1.0, filter, W, H,
+          stride, nb, state.sums.data(), [](size_t) { return true; }, scratch);
       ++state.units_done;
       if (passes::end_pass(state, stats, pass_start, opt, batches)) break;
     }
@@ -143,7 +115,6 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
   distributed::sum_stats(comm, state.stats);
   per_chunk.clear();
   per_chunk.shrink_to_fit();
-  sorted = {};
   RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};
   const int64_t done = std::min(total, state.units_done * kChunksPerBatch * kChunk);
   result.light_paths = done;

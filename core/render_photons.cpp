@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include "core/distributed/render_gather.h"
 #include "core/integrators/camera_ball.h"
@@ -127,8 +128,9 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
   indirect_tracer.set_camera_ball(ball);
   BeamBvh ball_bvh;
   uint64_t ball_beams_max = 0;
-  std::vector<uint32_t> splat_offsets;
-  std::vector<const Splat*> splat_order;
+  // The indirect light paths' splats and ball beams, per chunk; kept across passes (memory reused).
+  std::vector<std::tuple<std::vector<Splat>, std::vector<Beam>>> indirect_lists;
+  SplatScratch splat_scratch;
   double seconds_beams = 0, seconds_photons = 0, seconds_light_paths = 0, seconds_camera = 0;
   auto since = [](std::chrono::steady_clock::time_point& t0) {  // seconds since t0; t0 = now
     const auto t1 = std::chrono::steady_clock::now();
@@ -174,7 +176,7 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
       }
       BeamGather ball_gather;
       if (light_indirect) {
-        auto traced = trace_in_chunks_multi<Splat, Beam>(
+        trace_in_chunk_lists<Splat, Beam>(
             indirect_paths, kIndirectChunk, photon_stats,
             [&](int64_t i, std::vector<Splat>& out, std::vector<Beam>& through_ball,
                 PathStats& st) {
@@ -182,13 +184,16 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
                                         static_cast<uint64_t>(i));
               indirect_tracer.trace(rng, out, st, &through_ball);
             },
-            opt.comm);
-        const std::vector<Splat>& splats = std::get<0>(traced);
+            indirect_lists, opt.comm);
         if (ball.active()) {
           // The gather kernel shrinks with the caustic beams' schedule.
           const double ratio = beam_schedule.radius() / bd.radius;
-          ball_beams_max = std::max<uint64_t>(ball_beams_max, std::get<1>(traced).size());
-          ball_bvh.build(std::move(std::get<1>(traced)), ball.widest(ratio));
+          std::vector<Beam> ball_beams;
+          for (const auto& lists : indirect_lists)
+            ball_beams.insert(ball_beams.end(), std::get<1>(lists).begin(),
+                              std::get<1>(lists).end());
+          ball_beams_max = std::max<uint64_t>(ball_beams_max, ball_beams.size());
+          ball_bvh.build(std::move(ball_beams), ball.widest(ratio));
           pass_bytes += ball_bvh.memory_bytes();
           ball_gather.bvh = &ball_bvh;
           ball_gather.scene = &scene;
@@ -202,15 +207,15 @@ RenderResult render_photons(const Scene& scene, const RenderOptions& opt) {
           beam_gather.ball_radius = ball.radius;
         }
         // Each rank keeps the splats of its own bands of tile rows (gathered at the end).
-        deposit_splats(
-            splats, 1.0 / static_cast<double>(indirect_paths), filter, pixels, stride, nb,
-            state.sums.data(),
+        const size_t n_splats = deposit_splats(
+            indirect_lists.size(),
+            [&](size_t c) -> const std::vector<Splat>& { return std::get<0>(indirect_lists[c]); },
+            1.0 / static_cast<double>(indirect_paths), filter, W, H, stride, nb, state.sums.data(),
             [&](size_t p) {
               return comm.owns(static_cast<int64_t>(p / static_cast<size_t>(W)) / kTile);
             },
-            splat_offsets, splat_order);
-        pass_bytes += splats.size() * (sizeof(Splat) + sizeof(const Splat*)) +
-                      (pixels + 1) * sizeof(uint32_t) * 2;
+            splat_scratch);
+        pass_bytes += n_splats * (sizeof(Splat) + 2 * sizeof(const Splat*));
         seconds_light_paths += since(part_start);
       }
       state.photon_peak_bytes = std::max(state.photon_peak_bytes, pass_bytes);

@@ -38,16 +38,17 @@ void concat(std::vector<Lists>& per_chunk, Lists& all, std::index_sequence<I...>
 }  // namespace chunked_detail
 
 /// Calls trace(i, outs..., stats) for every path i in [0, count), `chunk` paths per task; `outs`
-/// are the chunk's std::vector<Ts>... (one list per kind of record). Counters are summed into
-/// `stats` (across ranks: this rank's chunks).
+/// are the chunk's std::vector<Ts>... (one list per kind of record), left in `per_chunk` (one
+/// tuple per chunk, in path order), which the caller keeps across calls so that the lists'
+/// memory is reused. Counters are summed into `stats` (across ranks: this rank's chunks).
 template <class... Ts, class Trace>
-std::tuple<std::vector<Ts>...> trace_in_chunks_multi(int64_t count, int64_t chunk, PathStats& stats,
-                                                     Trace&& trace,
-                                                     const distributed::Comm* comm = nullptr) {
-  using Lists = std::tuple<std::vector<Ts>...>;
+void trace_in_chunk_lists(int64_t count, int64_t chunk, PathStats& stats, Trace&& trace,
+                          std::vector<std::tuple<std::vector<Ts>...>>& per_chunk,
+                          const distributed::Comm* comm = nullptr) {
   const distributed::Comm& job = comm ? *comm : distributed::alone();
   const int64_t chunks = (count + chunk - 1) / chunk;
-  std::vector<Lists> per_chunk(static_cast<size_t>(chunks));
+  per_chunk.resize(static_cast<size_t>(chunks));
+  for (auto& lists : per_chunk) std::apply([](auto&... outs) { (outs.clear(), ...); }, lists);
   tbb::enumerable_thread_specific<PathStats> local;
   tbb::parallel_for(tbb::blocked_range<int64_t>(0, chunks, 1),
                     [&](const tbb::blocked_range<int64_t>& r) {
@@ -79,6 +80,16 @@ std::tuple<std::vector<Ts>...> trace_in_chunks_multi(int64_t count, int64_t chun
             per_chunk[static_cast<size_t>(c)]);
     });
   }
+}
+
+/// The same, with each kind's lists concatenated in path order.
+template <class... Ts, class Trace>
+std::tuple<std::vector<Ts>...> trace_in_chunks_multi(int64_t count, int64_t chunk, PathStats& stats,
+                                                     Trace&& trace,
+                                                     const distributed::Comm* comm = nullptr) {
+  using Lists = std::tuple<std::vector<Ts>...>;
+  std::vector<Lists> per_chunk;
+  trace_in_chunk_lists<Ts...>(count, chunk, stats, trace, per_chunk, comm);
   Lists all;
   chunked_detail::concat(per_chunk, all, std::index_sequence_for<Ts...>{});
   return all;
