@@ -14,6 +14,7 @@
 #include "core/integrators/light_tracer.h"
 #include "core/integrators/photon_beams.h"
 #include "core/integrators/photon_map.h"
+#include "core/integrators/splat_deposit.h"
 #include "core/pixel_sampler.h"
 #include "core/progress.h"
 #include "core/reconstruction.h"
@@ -242,12 +243,11 @@ RenderMemory render_memory(int width, int height, int bins, const RenderOptions&
             : opt.integrator == IntegratorKind::Beams
                 ? default_beam_paths_per_pass(static_cast<int64_t>(pixels))
                 : default_caustic_beam_paths_per_pass(static_cast<int64_t>(pixels))));
-  // The hybrid's light-traced share: at most about 8 splats per light path (light tracing's).
+  // The hybrid's light-traced share: its splats and their sort.
   if (opt.integrator == IntegratorKind::Hybrid)
-    m.integrator +=
-        static_cast<uint64_t>(hybrid_light_paths_per_pass(opt, static_cast<int64_t>(pixels))) *
-            8 * (sizeof(Splat) + sizeof(const Splat*)) +
-        (pixels + 1) * 8;
+    m.integrator += splat_bytes(static_cast<uint64_t>(
+                        hybrid_light_paths_per_pass(opt, static_cast<int64_t>(pixels)))) +
+                    (pixels + 1) * sizeof(uint32_t);
   if (opt.integrator == IntegratorKind::Light) m.integrator = light_batch_bytes(pixels);
   // Writing: a frame, the peak-time image, the contact sheet's 16 frames and its 8-bit image,
   // the 8-bit preview; a multipart EXR is written from the film itself.

@@ -25,10 +25,9 @@ constexpr uint64_t kLightStream = 0x4000000000000000ULL;  // apart from camera p
 }  // namespace
 
 uint64_t light_batch_bytes(uint64_t pixels) {
-  // About 8 splats per light path (one per vertex and per medium ray piece that the camera sees:
-  // 7.7 in the default scene) and their sort.
-  const uint64_t splats = static_cast<uint64_t>(kChunk * kChunksPerBatch) * 8;
-  return splats * (sizeof(Splat) + sizeof(const Splat*)) + (pixels + 1) * sizeof(uint32_t) * 2;
+  // A batch's splats and their sort, and at most a film's worth of per-pixel offsets.
+  return splat_bytes(static_cast<uint64_t>(kChunk * kChunksPerBatch)) +
+         (pixels + 1) * sizeof(uint32_t);
 }
 
 RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
@@ -115,6 +114,8 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
   distributed::sum_stats(comm, state.stats);
   per_chunk.clear();
   per_chunk.shrink_to_fit();
+  scratch.by_band = {};
+  scratch.by_pixel = {};
   RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};
   const int64_t done = std::min(total, state.units_done * kChunksPerBatch * kChunk);
   result.light_paths = done;
