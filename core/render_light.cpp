@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <chrono>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "core/distributed/bytes.h"
 #include "core/distributed/render_gather.h"
@@ -116,6 +119,11 @@ RenderResult render_light(const Scene& scene, const RenderOptions& opt) {
   per_chunk.shrink_to_fit();
   scratch.by_band = {};
   scratch.by_pixel = {};
+#if defined(__GLIBC__)
+  // The splat lists grew in the heap, whose freed pages stay resident: hand them back before
+  // the film is built (the memory estimate counts film and sums, not the splats, at that point).
+  malloc_trim(0);
+#endif
   RenderResult result{TransientFilm(W, H, axis), state.stats, state.seconds, threads, {}, {}, 0};
   const int64_t done = std::min(total, state.units_done * kChunksPerBatch * kChunk);
   result.light_paths = done;
