@@ -217,6 +217,12 @@ TEST_CASE("auto connects the segments whose light term peaks narrowly", "[time-s
   CHECK_FALSE(connect_segment_to(o, d, 20.0, 0.1, {25, 0.1, 0}));
   // A clear, endless segment has no collisions to lean on.
   CHECK(connect_segment_to(o, d, std::numeric_limits<double>::infinity(), 0.0, {1e3, 1e3, 0}));
+  // The wider fraction of the mean-free-path pairs, on the same segment.
+  const double k = kNearPairFraction * 10;
+  CHECK(connect_segment_to(o, d, 100.0, 0.1, {50, 0.95 * k, 0}, kNearPairFraction));
+  CHECK_FALSE(connect_segment_to(o, d, 100.0, 0.1, {50, 1.05 * k, 0}, kNearPairFraction));
+  // A segment shorter than the mean free path keeps 0.1 of its length.
+  CHECK_FALSE(connect_segment_to(o, d, 5.0, 0.0001, {2.5, 0.6, 0}, kNearPairFraction));
 }
 
 // Catches: a bound in box_far_from_light that is too small (auto would skip the first rule on a
@@ -228,14 +234,15 @@ TEST_CASE("auto connects the segments whose light term peaks narrowly", "[time-s
 TEST_CASE("no segment inside a box connects to a light the box is far from", "[time-sampling]") {
   Rng rng(20261203, 1);
   int far = 0, near_edge = 0, segments = 0;
+  const double fraction = std::fmax(kConnectionPeakFraction, kNearPairFraction);  // the wider
   for (int trial = 0; trial < 4000; ++trial) {
     const Vec3 lo(rng.uniform() * 10 - 5, rng.uniform() * 10 - 5, rng.uniform() * 10 - 5);
     const Vec3 hi =
         lo + Vec3(0.1 + rng.uniform() * 20, 0.1 + rng.uniform() * 20, 0.1 + rng.uniform() * 20);
     const bool homogeneous = trial % 2 == 0;
     const double sigma_t = std::pow(10.0, rng.uniform() * 4 - 2);  // 0.01 to 100 per mm
-    double bound = kConnectionPeakFraction * length(hi - lo);
-    if (homogeneous) bound = std::fmin(bound, kConnectionPeakFraction / sigma_t);
+    double bound = fraction * length(hi - lo);
+    if (homogeneous) bound = std::fmin(bound, fraction / sigma_t);
     // A light off the middle of a random face, 0.3 to 3 bounds away from it.
     const int axis = trial % 3, side = (trial / 3) % 2;
     Vec3 p((lo.x + hi.x) / 2, (lo.y + hi.y) / 2, (lo.z + hi.z) / 2);
@@ -280,7 +287,7 @@ TEST_CASE("no segment inside a box connects to a light the box is far from", "[t
                        ((d.z > 0 ? hi.z : lo.z) - o.z) / d.z})
         if (t >= 0) s_full = std::fmin(s_full, t);
       const double sigma_o = homogeneous ? sigma_t : std::pow(10.0, rng.uniform() * 6 - 3);
-      CHECK_FALSE(connect_segment_to(o, d, s_full, sigma_o, p));
+      CHECK_FALSE(connect_segment_to(o, d, s_full, sigma_o, p, fraction));
     }
     // And the worst case: a segment across the whole face, just inside it, under the light.
     {
@@ -299,17 +306,18 @@ TEST_CASE("no segment inside a box connects to a light the box is far from", "[t
       (ta == 0 ? o.x : ta == 1 ? o.y : o.z) = ta == 0 ? lo.x : ta == 1 ? lo.y : lo.z;
       (ta == 0 ? d.x : ta == 1 ? d.y : d.z) = 1.0;
       const double s_full = ta == 0 ? hi.x - lo.x : ta == 1 ? hi.y - lo.y : hi.z - lo.z;
-      CHECK_FALSE(connect_segment_to(o, d, s_full, homogeneous ? sigma_t : 1.0 / s_full, p));
+      CHECK_FALSE(
+          connect_segment_to(o, d, s_full, homogeneous ? sigma_t : 1.0 / s_full, p, fraction));
     }
   }
   CHECK(far > 2500);
   CHECK(near_edge > 100);  // the edge of the bound is exercised
   // Closer than the bound, a segment along the face below the light connects, and the box is
   // not far: the bound is not loose by much.
-  const Vec3 lo(0, 0, 0), hi(10, 10, 10), p(5, 5, 10.05);
-  CHECK_FALSE(box_far_from_light(lo, hi, 1.0, p));                  // 0.05 < 0.1 mean free path
-  CHECK(connect_segment_to({5, 5, 9.99}, {1, 0, 0}, 3.0, 1.0, p));  // 0.06 from the line
-  CHECK(box_far_from_light(lo, hi, 1.0, {5, 5, 10.11}));
+  const Vec3 lo(0, 0, 0), hi(10, 10, 10), p(5, 5, 10 + 0.5 * fraction);
+  CHECK_FALSE(box_far_from_light(lo, hi, 1.0, p));  // half the bound (mean free path 1)
+  CHECK(connect_segment_to({5, 5, 9.99}, {1, 0, 0}, 3.0, 1.0, p, fraction));
+  CHECK(box_far_from_light(lo, hi, 1.0, {5, 5, 10 + 1.02 * fraction}));
 }
 
 // Catches: the starvation rule reading the window or the extinction wrongly (a camera segment
@@ -371,6 +379,48 @@ TEST_CASE("auto's camera-segment MIS is unbiased and pays in the late frames", "
   }
   INFO("late relative variance, auto " << v_auto << ", collisions " << v_collision);
   CHECK(v_auto < 0.25 * v_collision);
+}
+
+// Catches: a near-light segment whose equiangular connection and collisions do not share the
+// light by weights summing to one (e.g. the collisions keeping weight 1: the light counted twice
+// in every bin), a pair that never engages (the light's peak left to collisions, whose 1 / r^2
+// there gives fireflies) and the connection alone (the frames far from the light's foot, where
+// equiangular sampling puts few vertices and collisions many). The light sits 1 mm beside the
+// camera ray, 40 mm ahead (one tenth of the mean free path is 1.7 mm: a near segment): every
+// vertex before it lands in the same frame, the peak; the later frames see the ray beyond it.
+TEST_CASE("auto's near-light MIS of an equiangular connection and the collisions",
+          "[time-sampling]") {
+  SingleScatterSetup p;
+  p.h = 1.0;
+  p.z0 = 40.0;
+  p.axis.t_start_ps = 140;
+  p.axis.bin_width_ps = 10;
+  p.axis.bins = 30;
+  const int peak = p.axis.bin_of(p.onset_ps());
+  REQUIRE(peak >= 0);
+  std::vector<double> rv[3];  // relative variances per bin at 1000 samples
+  const ConnectionSampling kinds[3] = {ConnectionSampling::Auto, ConnectionSampling::Equiangular,
+                                       ConnectionSampling::Collision};
+  for (int k = 0; k < 3; ++k) {
+    SceneDesc d = p.scene();
+    d.media[0].connection = kinds[k];
+    const auto films = render_batches(d, 1000, 16, /*max_depth=*/1);
+    for (int i = 0; i < p.axis.bins; ++i) {
+      const auto [m, expected] = check_bin(films, p, i, name_of(kinds[k]));
+      rv[k].push_back(expected > 0 ? std::pow(m.se / expected, 2) : 0.0);
+    }
+  }
+  INFO("peak bin " << peak << ": relative variance auto " << rv[0][peak] << ", equiangular "
+                   << rv[1][peak] << ", collisions " << rv[2][peak]);
+  double far[3] = {0, 0, 0};  // pooled over the frames well past the peak
+  for (int k = 0; k < 3; ++k)
+    for (int i = peak + 5; i < p.axis.bins; ++i) far[k] += rv[k][i];
+  INFO("far bins: auto " << far[0] << ", equiangular " << far[1] << ", collisions " << far[2]);
+  // Measured: 0.036 of the collisions' at the peak; 0.38 of equiangular's and 0.64 of the
+  // collisions' in the far bins.
+  CHECK(rv[0][peak] < 0.2 * rv[2][peak]);
+  CHECK(far[0] < 0.6 * far[1]);
+  CHECK(far[0] < 1.2 * far[2]);
 }
 
 // Catches: with several point lights (no single light's plan made once per segment), a light

@@ -1,15 +1,20 @@
 #pragma once
 // Where segment connections pay (connection_sampling "auto"). Next-event estimation at the
 // path's collisions has, per unit time, the lowest error on typical pixels (femto-bench-sampling),
-// but near a point light its 1/r^2 gives fireflies; an equiangular connection removes them at a
-// higher cost per segment. So a segment uses connections only when the light's
-// direct term along it has a peak much narrower than the spread of the collisions that sample it:
-// peak width w = the light's distance from the line (foot on the segment), from the start (foot
-// behind) or from the end (foot beyond); spread = min(segment length, mean free path).
-// Spot lights always use connections: their cone lights only a short stretch of a segment, which
-// collisions rarely hit, while equiangular sampling spreads over the light's angles and so over
-// the cone. The choice depends only on the segment and the light, never on a sampled distance, so
-// the two estimators split the light between them without bias.
+// but near a point light its 1/r^2 gives fireflies; an equiangular connection removes them at the
+// cost of a shadow ray. So a segment adds a connection only when the light's direct term along
+// it has a peak much narrower than the spread of the collisions that sample it: peak width w =
+// the light's distance from the line (foot on the segment), from the start (foot behind) or from
+// the end (foot beyond); spread = min(segment length, mean free path). Under mean-free-path
+// distances a point light's connection and the collisions then share the light by the balance
+// heuristic: the connection's vertices crowd the peak, the collisions keep the frames far from
+// it (where equiangular vertices are sparse), so neither loses where the other is better.
+// Spot lights always use connections, alone: their cone lights only a short stretch of a
+// segment, which collisions rarely hit, while equiangular sampling spreads over the light's
+// angles and so over the cone. The choice depends only on the segment and the light, never on a
+// sampled distance, so the estimators split the light between them without bias.
+// Where a time rule below also holds for a segment, its pair takes the segment instead (measured:
+// adding the equiangular vertex to it cost the fog corridors 13-16% of their efficiency).
 // Second rule, for the frames a camera segment reaches late: when its reachable part spans 3 to
 // 16 mean free paths and the light lies behind its start (a source beside the camera: the light
 // term falls from the start on and covers all the segment's frames), collisions leave the late
@@ -33,8 +38,16 @@
 
 namespace femto {
 
-/// Segments whose peak is narrower than this fraction of the collision spread use connections.
+/// Segments whose peak is narrower than this fraction of the collision spread use a connection
+/// instead of the collisions (distance sampling other than mean free path: `mis + auto`).
 constexpr double kConnectionPeakFraction = 0.1;
+/// ... and under mean-free-path distances, where the connection and the collisions share the
+/// light by MIS, so that a wider reach costs shadow rays but no variance, on segments spanning a
+/// mean free path: collisions' relative second moment of the light's peak is about
+/// 1 / (2 pi sigma_t h) at distance h from the light, above 1 once h < 0.16 mean free paths.
+/// 0.2 measured best of 0.1-0.4; shorter segments keep 0.1 of their length (0.2 of it cost the
+/// thin fog room 4-10% on typical pixels: a shadow ray on many segments that hold no collision).
+constexpr double kNearPairFraction = 0.2;
 
 /// The extinction that sets how far the collisions of a segment starting at o spread: the local
 /// value, or in a voxel medium where o lies in empty space (a camera outside a cloud), the grid's
@@ -46,9 +59,10 @@ inline double spread_sigma_t(const Medium& med, const Vec3& o) {
 }
 
 /// Whether the segment o + s d, s in [0, s_full), in a medium with extinction sigma_t (at o)
-/// gathers the direct light of the point light at p by segment connections.
+/// gathers the direct light of the point light at p by segment connections; `fraction` of the
+/// spread when that is the mean free path, kConnectionPeakFraction of the segment's length else.
 inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, double sigma_t,
-                               const Vec3& p) {
+                               const Vec3& p, double fraction = kConnectionPeakFraction) {
   // spread = min(s_full, 1 / sigma_t); compared squared and without a division (every segment
   // asks).
   const bool mfp_spread = sigma_t * s_full >= 1.0;  // false for a clear medium (also 0 x inf)
@@ -63,8 +77,9 @@ inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, doub
     w2 = length_squared(p - (o + d * s_full));
   else
     w2 = std::fmax(length_squared(l) - delta * delta, 0.0);
-  constexpr double k2 = kConnectionPeakFraction * kConnectionPeakFraction;
-  return mfp_spread ? w2 * sigma_t * sigma_t < k2 : w2 < k2 * s_full * s_full;
+  const double k2 = fraction * fraction;
+  constexpr double k2_len = kConnectionPeakFraction * kConnectionPeakFraction;
+  return mfp_spread ? w2 * sigma_t * sigma_t < k2 : w2 < k2_len * s_full * s_full;
 }
 
 /// Whether no segment inside the box [lo, hi] can connect to the point light at p under
@@ -76,7 +91,7 @@ inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, doub
 inline bool box_far_from_light(const Vec3& lo, const Vec3& hi, double sigma_t, const Vec3& p) {
   double spread = length(hi - lo);
   if (sigma_t > 0) spread = std::fmin(spread, 1.0 / sigma_t);
-  const double k = 1.01 * kConnectionPeakFraction * spread;
+  const double k = 1.01 * std::fmax(kConnectionPeakFraction, kNearPairFraction) * spread;
   const Vec3 gap = vmax(vmax(lo - p, p - hi), Vec3(0.0));
   return length_squared(gap) >= k * k;
 }
@@ -123,9 +138,9 @@ inline bool lights_from_start(const Vec3& o, const Vec3& d, const Vec3& p) {
 /// The auto rule for one light: spot lights always connect (their cone), point lights by
 /// connect_segment_to. Both the segment estimate and the collision vertices ask this.
 inline bool auto_connects(const Light& light, const Vec3& o, const Vec3& d, double s_full,
-                          double sigma_t) {
+                          double sigma_t, double fraction = kConnectionPeakFraction) {
   return light.type == Light::Type::Spot ||
-         connect_segment_to(o, d, s_full, sigma_t, light.position);
+         connect_segment_to(o, d, s_full, sigma_t, light.position, fraction);
 }
 
 }  // namespace femto

@@ -161,11 +161,13 @@ VolPathIntegrator::LineToPointTarget VolPathIntegrator::line_to_point_target(
   return target;
 }
 
-double VolPathIntegrator::collision_density(const Medium& med, int m, const Ray& ray,
-                                            double s) const {
-  double tau, opl;
-  tracker_.segment_integrals(m, ray, s, tau, opl);
-  return med.sigma_t_at(ray.at(s)) * std::exp(-tau);
+EquiangularSampler VolPathIntegrator::near_equiangular(const Medium& med,
+                                                       const ConnectedSegment& segment,
+                                                       const Light& L) const {
+  const Ray& ray = segment.ray();
+  const double s_end = line_to_point_target(med, segment, L, false).s_end;
+  return s_end > 0 ? EquiangularSampler(ray.o, ray.d, L.position, 0.0, s_end)
+                   : EquiangularSampler();
 }
 
 void VolPathIntegrator::estimate_segment(const Medium& med, int m, const ConnectedSegment& segment,
@@ -185,13 +187,17 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Connect
   // The partition's share (connections alone), or on a time_mis segment the connection's half of
   // its MIS with the collisions.
   const bool partition = segment.covers(L);
-  if (!partition && !segment.mis_with_collisions(L))
-    return;  // collision next-event estimation's share
+  const bool eq_pair = !partition && segment.pairs_equiangular(L);
+  const bool lp_pair = !partition && segment.mis_with_collisions(L);
+  if (!partition && !eq_pair && !lp_pair) return;  // collision next-event estimation's share
 
-  // auto's partition connects only where the light term peaks narrowly: equiangular's case.
-  const bool use_eq = partition && kind != ConnectionSampling::LineToPoint;
+  // auto connects by equiangular sampling where the light term peaks narrowly and by
+  // line-to-point on time_mis segments, each by MIS with the collisions (both where both rules
+  // hold).
+  const bool use_eq = eq_pair || (partition && kind != ConnectionSampling::LineToPoint);
   const bool use_lp =
-      !partition || kind == ConnectionSampling::LineToPoint || kind == ConnectionSampling::Mis;
+      lp_pair ||
+      (partition && (kind == ConnectionSampling::LineToPoint || kind == ConnectionSampling::Mis));
   const LineToPointTarget target = !partition && segment.lp_target
                                        ? *segment.lp_target
                                        : line_to_point_target(med, segment, L, use_lp);

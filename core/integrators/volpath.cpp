@@ -122,7 +122,16 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
 
 bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
   if (!active) return false;
-  return all || decided || auto_connects(light, ray_ptr->o, ray_ptr->d, s_surf, sigma_t);
+  if (all) return true;
+  if (near_mis && light.type == Light::Type::Point) return false;  // pairs_equiangular's
+  return decided || auto_connects(light, ray_ptr->o, ray_ptr->d, s_surf, sigma_t);
+}
+
+bool VolPathIntegrator::ConnectedSegment::pairs_equiangular(const Light& light) const {
+  return active && near_mis && !all && light.type == Light::Type::Point &&
+         !mis_with_collisions(light) &&
+         (decided || connect_segment_to(ray_ptr->o, ray_ptr->d, s_surf, sigma_t, light.position,
+                                        kNearPairFraction));
 }
 
 bool VolPathIntegrator::ConnectedSegment::mis_with_collisions(const Light& light) const {
@@ -132,7 +141,8 @@ bool VolPathIntegrator::ConnectedSegment::mis_with_collisions(const Light& light
 void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, double s_surf,
                                      double t, double t_factor, bool camera_segment,
                                      ConnectedSegment& segment) const {
-  segment.active = segment.all = segment.decided = segment.time_mis = segment.thin = false;
+  segment.active = segment.all = segment.decided = segment.time_mis = segment.thin =
+      segment.near_mis = false;
   segment.lp_target.reset();
   if (med.connection == ConnectionSampling::Collision || point_lights_.empty() || !med.interacts())
     return;
@@ -158,24 +168,26 @@ void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, d
       !segment.time_mis && mfp && thin_media_[mi] && thin_segment(s_surf, budget, segment.sigma_t);
   segment.time_mis = segment.time_mis || segment.thin;
   const LightSet& lights = scene_.lights();
+  const double fraction = mfp ? kNearPairFraction : kConnectionPeakFraction;
   for (int li : point_lights_)
-    if (auto_connects(lights.light(li), ray.o, ray.d, s_surf, segment.sigma_t)) {
+    if (auto_connects(lights.light(li), ray.o, ray.d, s_surf, segment.sigma_t, fraction)) {
       segment.active = true;
       break;
     }
   segment.decided = point_lights_.size() == 1;
-  if (segment.decided && !segment.active) {
+  segment.near_mis = mfp;
+  if (segment.decided) {
     const Light& L = lights.light(point_lights_[0]);
-    if (segment.mis_with_collisions(L))
+    if (!segment.covers(L) && segment.mis_with_collisions(L))
       segment.lp_target = line_to_point_target(med, segment, L, true);
   }
 }
 
 void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g,
                                                const RGB& beta, double t, const DirectionMix* mix,
-                                               const ConnectedSegment& segment, double s_seg,
-                                               Rng& rng, PixelAccumulator& acc,
-                                               PathStats& stats) const {
+                                               const ConnectedSegment& segment,
+                                               const DistanceEvent* collision, Rng& rng,
+                                               PixelAccumulator& acc, PathStats& stats) const {
   const LightSet& lights = scene_.lights();
   double pmf = 0;
   const int li = lights.pick(rng.uniform(), pmf);
@@ -183,19 +195,23 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
   LightSample ls;
   if (li < 0 || beta.is_black()) return;
   const Light& L = lights.light(li);
-  double w_seg = 1.0;  // the collisions' balance-heuristic weight on a time_mis segment
+  double w_seg = 1.0;  // the collisions' balance-heuristic weight against the segment's connections
   if (L.type == Light::Type::Laser) return;  // estimate_laser_chords' share
   if (is_point_like(L)) {
     if (segment.covers(L)) return;  // estimate_segment's share
-    if (s_seg >= 0 && segment.mis_with_collisions(L)) {
+    const bool eq_pair = segment.pairs_equiangular(L), lp_pair = segment.mis_with_collisions(L);
+    if (collision && (eq_pair || lp_pair)) {
       const Medium& med = scene_.media()[static_cast<size_t>(m)];
-      const LineToPointTarget target =
-          segment.lp_target ? *segment.lp_target : line_to_point_target(med, segment, L, true);
-      const double p_lp =
-          target.valid && s_seg < target.s_end ? target.lp.pdf(target.win, s_seg) : 0.0;
-      if (p_lp > 0) {
-        const double p_c = collision_density(med, m, segment.ray(), s_seg);
-        w_seg = p_c / (p_c + p_lp);
+      const double s_seg = collision->s;
+      double p_other = eq_pair ? near_equiangular(med, segment, L).pdf(s_seg) : 0.0;
+      if (lp_pair) {
+        const LineToPointTarget target =
+            segment.lp_target ? *segment.lp_target : line_to_point_target(med, segment, L, true);
+        if (target.valid && s_seg < target.s_end) p_other += target.lp.pdf(target.win, s_seg);
+      }
+      if (p_other > 0) {
+        const double p_c = collision->sigma_t * std::exp(-collision->tau);
+        w_seg = p_c / (p_c + p_other);
       }
     }
   }
@@ -357,7 +373,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
             angular ? direction_mix(med, x2, t2, u_next, depth + 1) : DirectionMix{};
         estimate_direct_medium(x2, m, ray.d, med.g(),
                                beta * (MediumTracker::albedo_at(med, x2) * ms.extra_nee_weight), t2,
-                               angular ? &mix2 : nullptr, segment, -1.0, rng, acc, stats);
+                               angular ? &mix2 : nullptr, segment, nullptr, rng, acc, stats);
       }
       const DistanceEvent& ev = ms.main;
       if (!ev.collided && !found) break;  // escaped to infinity
@@ -383,7 +399,7 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
         beta *= MediumTracker::albedo_at(med, x);
         if (beta.is_black()) break;
         estimate_direct_medium(x, m, ray.d, med.g(), beta * ms.main_nee_weight, t,
-                               angular ? &mix_main : nullptr, segment, ev.s, rng, acc, stats);
+                               angular ? &mix_main : nullptr, segment, &ev, rng, acc, stats);
         Vec3 wi;
         beta *=
             sample_direction(mix_main, x, ray.d, med.g(), rng, wi, prev_pdf);  // 1 for phase alone

@@ -15,6 +15,7 @@
 #include "core/scene.h"
 #include "core/temporal_filter.h"
 #include "core/transport/tracker.h"
+#include "samplers/equiangular.h"
 #include "samplers/line_to_point.h"
 #include "samplers/medium_distance.h"
 
@@ -95,6 +96,10 @@ class VolPathIntegrator {
     /// media (connection_choice.h, third rule): for every such light, not only those behind the
     /// segment's start.
     bool thin = false;
+    /// auto with mean-free-path distances: a point light near the segment (connect_segment_to)
+    /// is shared between one equiangular connection and the collisions' next-event estimation by
+    /// the balance heuristic instead of left to the connection alone.
+    bool near_mis = false;
     // Set by plan_segment when a flag is: not initialised here, so a path's plan costs no
     // zeroing.
     const Ray* ray_ptr;
@@ -104,6 +109,8 @@ class VolPathIntegrator {
     bool covers(const Light& light) const;
     /// time_mis for this light: the light lies behind the segment's start (lights_from_start).
     bool mis_with_collisions(const Light& light) const;
+    /// near_mis for this light: a point light near the segment.
+    bool pairs_equiangular(const Light& light) const;
     /// With a single point light that mis_with_collisions: its target, made once per segment.
     std::optional<LineToPointTarget> lp_target;
   };
@@ -117,16 +124,18 @@ class VolPathIntegrator {
   /// A segment's line-to-point connection to light L (narrow: with its window).
   LineToPointTarget line_to_point_target(const Medium& med, const ConnectedSegment& segment,
                                          const Light& L, bool narrow_window) const;
-  /// Density of the segment's mean-free-path collisions at distance s (the balance heuristic's
-  /// other strategy on time_mis segments).
-  double collision_density(const Medium& med, int m, const Ray& ray, double s) const;
+  /// A segment's equiangular connection to point light L over the stretch whose vertices can
+  /// reach the film window.
+  EquiangularSampler near_equiangular(const Medium& med, const ConnectedSegment& segment,
+                                      const Light& L) const;
   /// Next-event estimation from a medium point x reached along direction d with throughput beta.
   /// `mix` (may be null) gives the direction density for MIS with area lights; point and spot
-  /// lights that `segment` covers are left to estimate_segment. s_seg: x's distance along the
-  /// segment when x is its mean-free-path collision (else < 0), for time_mis weights.
+  /// lights that `segment` covers are left to estimate_segment. collision: the segment's
+  /// mean-free-path collision when x is it (else null): its density sigma_t exp(-tau) weighs it
+  /// against the segment's connections.
   void estimate_direct_medium(const Vec3& x, int m, const Vec3& d, double g, const RGB& beta,
                               double t, const DirectionMix* mix, const ConnectedSegment& segment,
-                              double s_seg, Rng& rng, PixelAccumulator& acc,
+                              const DistanceEvent* collision, Rng& rng, PixelAccumulator& acc,
                               PathStats& stats) const;
   /// Direct light from a point or spot light scattered anywhere on [0, s_surf) of the segment's
   /// ray in medium m (equiangular, line-to-point, or both by MIS; on time_mis segments also

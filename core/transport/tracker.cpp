@@ -48,6 +48,7 @@ MediumSample MediumTracker::sample(const Medium& med, const Ray& ray, double s_m
       ev.collided = s < s_max;
       ev.s = ev.collided ? s : s_max;
       ev.opl = h.eta * ev.s;
+      ev.tau = h.sigma_t() * ev.s;
       ev.sigma_t = h.sigma_t();
       ev.eta = h.eta;
       ev.weight = h.sigma_s > 0 ? 1.0 : std::exp(-h.sigma_t() * s_max);
