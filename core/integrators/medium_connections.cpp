@@ -208,8 +208,9 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Connect
   double eq_a = 0.0, eq_b = s_end;
   const bool eq_lit =
       use_eq && (L.type != Light::Type::Spot || spot_cone_interval(L, ray, eq_a, eq_b));
-  const EquiangularSampler eq =
-      eq_lit ? EquiangularSampler(ray.o, ray.d, p, eq_a, eq_b) : EquiangularSampler();
+  const EquiangularSampler eq = eq_pair && segment.eq_target ? *segment.eq_target
+                                : eq_lit ? EquiangularSampler(ray.o, ray.d, p, eq_a, eq_b)
+                                         : EquiangularSampler();
   const bool eq_ok = eq.valid(), lp_ok = use_lp && target.valid;
 
   auto contribute = [&](double s) {

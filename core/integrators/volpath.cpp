@@ -144,6 +144,7 @@ void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, d
   segment.active = segment.all = segment.decided = segment.time_mis = segment.thin =
       segment.near_mis = false;
   segment.lp_target.reset();
+  segment.eq_target.reset();
   if (med.connection == ConnectionSampling::Collision || point_lights_.empty() || !med.interacts())
     return;
   segment.ray_ptr = &ray;  // the loop's ray, unchanged while the plan is used
@@ -180,6 +181,8 @@ void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, d
     const Light& L = lights.light(point_lights_[0]);
     if (!segment.covers(L) && segment.mis_with_collisions(L))
       segment.lp_target = line_to_point_target(med, segment, L, true);
+    else if (segment.pairs_equiangular(L))
+      segment.eq_target = near_equiangular(med, segment, L);
   }
 }
 
@@ -203,7 +206,9 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
     if (collision && (eq_pair || lp_pair)) {
       const Medium& med = scene_.media()[static_cast<size_t>(m)];
       const double s_seg = collision->s;
-      double p_other = eq_pair ? near_equiangular(med, segment, L).pdf(s_seg) : 0.0;
+      double p_other = !eq_pair            ? 0.0
+                       : segment.eq_target ? segment.eq_target->pdf(s_seg)
+                                           : near_equiangular(med, segment, L).pdf(s_seg);
       if (lp_pair) {
         const LineToPointTarget target =
             segment.lp_target ? *segment.lp_target : line_to_point_target(med, segment, L, true);

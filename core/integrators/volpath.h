@@ -113,6 +113,9 @@ class VolPathIntegrator {
     bool pairs_equiangular(const Light& light) const;
     /// With a single point light that mis_with_collisions: its target, made once per segment.
     std::optional<LineToPointTarget> lp_target;
+    /// With a single point light that pairs_equiangular: its sampler (near_equiangular), made
+    /// once per segment for the connection and the collisions' weights.
+    std::optional<EquiangularSampler> eq_target;
   };
   /// The segment's connection plan, decided once per segment (and without random draws, so a
   /// segment that connects nothing costs a few flops). m: the index of `med` in the scene's
