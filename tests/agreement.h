@@ -40,14 +40,9 @@ inline MediumDesc graded_voxel_medium(const std::filesystem::path& dir) {
   eta.update_range();
   const std::string file = (dir / "graded.vdb").string();
   write_volume(file, density, nullptr, &eta, 5.0, {-30, 0, -30});
-  MediumDesc m;
-  m.name = "vdb";
-  m.type = MediumDesc::Type::Vdb;
-  m.vdb.file = file;
-  m.vdb.albedo = 0.85;
+  MediumDesc m = vdb_medium("vdb", file, 0.85, 0.2);
   m.vdb.eta = 1.0;
   m.vdb.eta_grid = "eta";
-  m.medium.g = 0.2;
   return m;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 // Small scene-building helpers shared by the tracer tests.
+#include <string>
 #include <vector>
 
 #include "core/render.h"
@@ -60,6 +61,17 @@ inline MediumDesc medium(const char* name, double sigma_a, double sigma_s, doubl
   MediumDesc m;
   m.name = name;
   m.medium = HomogeneousMedium{sigma_a, sigma_s, g, eta};
+  return m;
+}
+
+/// A voxel medium read from `file` (grid "density", sigma_t = density / mm), constant albedo.
+inline MediumDesc vdb_medium(const char* name, const std::string& file, double albedo, double g) {
+  MediumDesc m;
+  m.name = name;
+  m.type = MediumDesc::Type::Vdb;
+  m.vdb.file = file;
+  m.vdb.albedo = albedo;
+  m.medium.g = g;
   return m;
 }
 

@@ -5,7 +5,9 @@
 // cost of a shadow ray. So a segment adds a connection only when the light's direct term along
 // it has a peak much narrower than the spread of the collisions that sample it: peak width w =
 // the light's distance from the line (foot on the segment), from the start (foot behind) or from
-// the end (foot beyond); spread = min(segment length, mean free path). Under mean-free-path
+// the end (foot beyond); spread = min(segment length, mean free path), the mean free path at the
+// light in a voxel medium (the collisions that sample the peak are those near it; at the
+// segment's start where the light sits in empty space). Under mean-free-path
 // distances a point light's connection and the collisions then share the light by the balance
 // heuristic: the connection's vertices crowd the peak, the collisions keep the frames far from
 // it (where equiangular vertices are sparse), so neither loses where the other is better.
@@ -58,7 +60,7 @@ inline double spread_sigma_t(const Medium& med, const Vec3& o) {
   return local > 0 ? local : med.grid->mean_sigma_t();
 }
 
-/// Whether the segment o + s d, s in [0, s_full), in a medium with extinction sigma_t (at o)
+/// Whether the segment o + s d, s in [0, s_full), in a medium with extinction sigma_t (at p or o)
 /// gathers the direct light of the point light at p by segment connections; `fraction` of the
 /// spread when that is the mean free path, kConnectionPeakFraction of the segment's length else.
 inline bool connect_segment_to(const Vec3& o, const Vec3& d, double s_full, double sigma_t,

@@ -186,8 +186,8 @@ void VolPathIntegrator::estimate_segment(const Medium& med, int m, const Connect
   const ConnectionSampling kind = med.connection;
   // The partition's share (connections alone), or on a time_mis segment the connection's half of
   // its MIS with the collisions.
-  const bool partition = segment.covers(L);
-  const bool eq_pair = !partition && segment.pairs_equiangular(L);
+  const bool partition = segment.covers(li, L);
+  const bool eq_pair = !partition && segment.pairs_equiangular(li, L);
   const bool lp_pair = !partition && segment.mis_with_collisions(L);
   if (!partition && !eq_pair && !lp_pair) return;  // collision next-event estimation's share
 

@@ -108,6 +108,17 @@ VolPathIntegrator::VolPathIntegrator(const Scene& scene, const TemporalFilter& f
   medium_bounds(scene, lo, hi);
   thin_media_ = thin_media_lit_from_outside(scene, point_lights_, lo, hi);
   far_media_ = media_far_from_lights(scene, point_lights_, lo, hi);
+  const std::vector<Medium>& media = scene.media();
+  const size_t n_lights = static_cast<size_t>(lights.count());
+  light_sigma_t_.assign(media.size() * n_lights, 0.0);
+  needs_spread_.assign(media.size(), 0);
+  for (size_t m = 0; m < media.size(); ++m)
+    for (int li : point_lights_) {
+      double& s = light_sigma_t_[m * n_lights + static_cast<size_t>(li)];
+      if (media[m].type == Medium::Type::Grid)
+        s = media[m].grid->sigma_t_at(lights.light(li).position);
+      needs_spread_[m] = needs_spread_[m] || !(s > 0);
+    }
 }
 
 void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
@@ -120,18 +131,18 @@ void VolPathIntegrator::deposit(double t_ps, double sigma_ps, const RGB& value,
   acc.add(filter_, t_ps, sigma_ps, value);
 }
 
-bool VolPathIntegrator::ConnectedSegment::covers(const Light& light) const {
+bool VolPathIntegrator::ConnectedSegment::covers(int li, const Light& light) const {
   if (!active) return false;
   if (all) return true;
   if (near_mis && light.type == Light::Type::Point) return false;  // pairs_equiangular's
-  return decided || auto_connects(light, ray_ptr->o, ray_ptr->d, s_surf, sigma_t);
+  return decided || auto_connects(light, ray_ptr->o, ray_ptr->d, s_surf, near_sigma_t(li));
 }
 
-bool VolPathIntegrator::ConnectedSegment::pairs_equiangular(const Light& light) const {
+bool VolPathIntegrator::ConnectedSegment::pairs_equiangular(int li, const Light& light) const {
   return active && near_mis && !all && light.type == Light::Type::Point &&
          !mis_with_collisions(light) &&
-         (decided || connect_segment_to(ray_ptr->o, ray_ptr->d, s_surf, sigma_t, light.position,
-                                        kNearPairFraction));
+         (decided || connect_segment_to(ray_ptr->o, ray_ptr->d, s_surf, near_sigma_t(li),
+                                        light.position, kNearPairFraction));
 }
 
 bool VolPathIntegrator::ConnectedSegment::mis_with_collisions(const Light& light) const {
@@ -141,10 +152,7 @@ bool VolPathIntegrator::ConnectedSegment::mis_with_collisions(const Light& light
 void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, double s_surf,
                                      double t, double t_factor, bool camera_segment,
                                      ConnectedSegment& segment) const {
-  segment.active = segment.all = segment.decided = segment.time_mis = segment.thin =
-      segment.near_mis = false;
-  segment.lp_target.reset();
-  segment.eq_target.reset();
+  segment.reset();
   if (med.connection == ConnectionSampling::Collision || point_lights_.empty() || !med.interacts())
     return;
   segment.ray_ptr = &ray;  // the loop's ray, unchanged while the plan is used
@@ -162,26 +170,31 @@ void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, d
     segment.decided = point_lights_.size() == 1;  // and no rule applies
     return;
   }
-  segment.sigma_t = spread_sigma_t(med, ray.o);
+  // The lookup (a voxel fetch in a grid) only where a rule reads it: the time rules, or a light
+  // whose first rule has no extinction of its own.
+  const bool time_rules = mfp && (camera_segment || thin_media_[mi]);
+  segment.sigma_t = time_rules || needs_spread_[mi] ? spread_sigma_t(med, ray.o) : 0.0;
+  const LightSet& lights = scene_.lights();
+  segment.light_sigma_t = &light_sigma_t_[mi * static_cast<size_t>(lights.count())];
   const double budget = kSpeedOfLight * (t_cut_ - t);
   segment.time_mis = camera_segment && mfp && starved_segment(s_surf, budget, segment.sigma_t);
   segment.thin =
       !segment.time_mis && mfp && thin_media_[mi] && thin_segment(s_surf, budget, segment.sigma_t);
   segment.time_mis = segment.time_mis || segment.thin;
-  const LightSet& lights = scene_.lights();
   const double fraction = mfp ? kNearPairFraction : kConnectionPeakFraction;
   for (int li : point_lights_)
-    if (auto_connects(lights.light(li), ray.o, ray.d, s_surf, segment.sigma_t, fraction)) {
+    if (auto_connects(lights.light(li), ray.o, ray.d, s_surf, segment.near_sigma_t(li), fraction)) {
       segment.active = true;
       break;
     }
   segment.decided = point_lights_.size() == 1;
   segment.near_mis = mfp;
   if (segment.decided) {
-    const Light& L = lights.light(point_lights_[0]);
-    if (!segment.covers(L) && segment.mis_with_collisions(L))
+    const int li = point_lights_[0];
+    const Light& L = lights.light(li);
+    if (!segment.covers(li, L) && segment.mis_with_collisions(L))
       segment.lp_target = line_to_point_target(med, segment, L, true);
-    else if (segment.pairs_equiangular(L))
+    else if (segment.pairs_equiangular(li, L))
       segment.eq_target = near_equiangular(med, segment, L);
   }
 }
@@ -201,8 +214,8 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
   double w_seg = 1.0;  // the collisions' balance-heuristic weight against the segment's connections
   if (L.type == Light::Type::Laser) return;  // estimate_laser_chords' share
   if (is_point_like(L)) {
-    if (segment.covers(L)) return;  // estimate_segment's share
-    const bool eq_pair = segment.pairs_equiangular(L), lp_pair = segment.mis_with_collisions(L);
+    if (segment.covers(li, L)) return;  // estimate_segment's share
+    const bool eq_pair = segment.pairs_equiangular(li, L), lp_pair = segment.mis_with_collisions(L);
     if (collision && (eq_pair || lp_pair)) {
       const Medium& med = scene_.media()[static_cast<size_t>(m)];
       const double s_seg = collision->s;
@@ -346,7 +359,14 @@ void VolPathIntegrator::trace(Ray ray, Rng& rng, PixelAccumulator& acc, PathStat
                               : 0.0;
       const MediumSample ms = tracker_.sample(med, ray, s_surf, rng, u_next, q_tu);
       const double t_dropped = unwarp_ && on_camera_segment ? 0.0 : 1.0 / kSpeedOfLight;
-      plan_segment(med, m, ray, s_surf, t, t_dropped, on_camera_segment, segment);
+      // Passed without meeting any extinction (a camera ray beside a cloud): no connection
+      // along it can gather light, so it gets no plan.
+      const bool clear =
+          med.strategy.kind == DistanceSampling::Mfp && !ms.main.collided && !(ms.main.tau > 0);
+      if (clear)
+        segment.reset();
+      else
+        plan_segment(med, m, ray, s_surf, t, t_dropped, on_camera_segment, segment);
       if ((segment.active || segment.time_mis) && medium_light)
         estimate_segment(med, m, segment, beta, rng, acc, stats);
       // On the camera's own segment a laser's beam is light tracing's (light_indirect), but

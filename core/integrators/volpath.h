@@ -103,14 +103,27 @@ class VolPathIntegrator {
     // Set by plan_segment when a flag is: not initialised here, so a path's plan costs no
     // zeroing.
     const Ray* ray_ptr;
-    double s_surf, sigma_t;
+    double s_surf;
+    double sigma_t;  ///< spread_sigma_t at ray.o: set only where a rule reads it (needs_spread)
+    /// The medium's row of light_sigma_t_ (by light index): the first rule's extinction per light.
+    const double* light_sigma_t;
     double t, t_factor;  ///< path time at ray.o (ps) and the OPL -> time factor
     const Ray& ray() const { return *ray_ptr; }
-    bool covers(const Light& light) const;
+    /// No connections: every flag down.
+    void reset() {
+      active = all = decided = time_mis = thin = near_mis = false;
+      lp_target.reset();
+      eq_target.reset();
+    }
+    /// The extinction the first rule (connect_segment_to) uses for light li.
+    double near_sigma_t(int li) const {
+      return light_sigma_t[li] > 0 ? light_sigma_t[li] : sigma_t;
+    }
+    bool covers(int li, const Light& light) const;
     /// time_mis for this light: the light lies behind the segment's start (lights_from_start).
     bool mis_with_collisions(const Light& light) const;
-    /// near_mis for this light: a point light near the segment.
-    bool pairs_equiangular(const Light& light) const;
+    /// near_mis for light li: a point light near the segment.
+    bool pairs_equiangular(int li, const Light& light) const;
     /// With a single point light that mis_with_collisions: its target, made once per segment.
     std::optional<LineToPointTarget> lp_target;
     /// With a single point light that pairs_equiangular: its sampler (near_equiangular), made
@@ -188,6 +201,13 @@ class VolPathIntegrator {
   /// Per medium: no point light can ever connect on its segments under the first rule
   /// (media_far_from_lights), so plan_segment skips the rules where no other one applies.
   std::vector<char> far_media_;
+  /// Per medium and light (m * lights + li): the extinction at a point light inside a voxel
+  /// medium, which sets the collisions' density at the peak of its direct term on every segment
+  /// that passes near it (connection_choice.h's first rule); 0 where the segment's own
+  /// spread_sigma_t stands in (homogeneous media, lights in empty voxels or outside the grid).
+  std::vector<double> light_sigma_t_;
+  /// Per medium: some point light's first rule reads the segment's spread_sigma_t.
+  std::vector<char> needs_spread_;
   std::vector<double> point_pmf_;  ///< their pick probabilities, proportional to power
   std::vector<int> lasers_;        ///< lasers: targets of laser chords
 };
