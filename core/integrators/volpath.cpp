@@ -189,7 +189,7 @@ void VolPathIntegrator::plan_segment(const Medium& med, int m, const Ray& ray, d
     }
   segment.decided = point_lights_.size() == 1;
   segment.near_mis = mfp;
-  if (segment.decided) {
+  if (segment.decided && (segment.active || segment.time_mis)) {
     const int li = point_lights_[0];
     const Light& L = lights.light(li);
     if (!segment.covers(li, L) && segment.mis_with_collisions(L))
@@ -213,7 +213,8 @@ void VolPathIntegrator::estimate_direct_medium(const Vec3& x, int m, const Vec3&
   const Light& L = lights.light(li);
   double w_seg = 1.0;  // the collisions' balance-heuristic weight against the segment's connections
   if (L.type == Light::Type::Laser) return;  // estimate_laser_chords' share
-  if (is_point_like(L)) {
+  // A segment without connections (most) leaves every point light to the collisions.
+  if (is_point_like(L) && (segment.active || segment.time_mis)) {
     if (segment.covers(li, L)) return;  // estimate_segment's share
     const bool eq_pair = segment.pairs_equiangular(li, L), lp_pair = segment.mis_with_collisions(L);
     if (collision && (eq_pair || lp_pair)) {
