@@ -9,7 +9,8 @@
 // noisy one `mfp + collision` render is per cell and per block: where that is near 1, a render
 // that leaves out most of the light scores well on the medians. The default configuration is
 // marked; it plays the scene's default Russian roulette, which every other configuration leaves off
-// ("default, no roulette" is the same sampling without it).
+// ("default, no roulette" is the same sampling without it; `--roulette D,T` adds the same sampling
+// with other roulettes).
 //
 // Error measure: per cell (pixel x bin, channels summed), the mean squared error of one render
 // against a long reference render (32x the samples, seeds of its own, so uncorrelated with every
@@ -98,7 +99,7 @@ std::string corridor_scene(double sigma_t, double albedo, double half) {
 }
 
 struct Config {
-  const char* name;
+  std::string name;
   DistanceSampling distance;
   ConnectionSampling connection;
   bool is_default;
@@ -117,6 +118,7 @@ struct RunOptions {
   double spp_scale = 1.0;
   bool all_cells = false;
   bool deciles = false;  ///< also "default vs it" per tenth of the window
+  std::vector<RouletteDesc> roulettes;  ///< extra configurations: the default with these
 };
 
 void run_scene(const BenchScene& bs, const RunOptions& ro) {
@@ -131,7 +133,7 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
     return;
   }
   const MediumDesc& m0 = base.media[0];
-  const Config configs[] = {
+  std::vector<Config> configs = {
       {"default (mfp + auto, roulette)", m0.sampling, m0.connection, true,
        base.integrator.roulette},
       {"default, no roulette", m0.sampling, m0.connection, false},
@@ -146,7 +148,13 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
       {"mixture + collision", DistanceSampling::Mixture, ConnectionSampling::Collision, false},
       {"mfp + collision", DistanceSampling::Mfp, ConnectionSampling::Collision, false},
   };
-  const int n = static_cast<int>(sizeof(configs) / sizeof(configs[0]));
+  // --roulette D,T: the default's sampling with another Russian roulette.
+  for (const RouletteDesc& r : ro.roulettes) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "default, roulette %d,%g", r.depth, r.threshold);
+    configs.push_back({name, m0.sampling, m0.connection, false, r});
+  }
+  const int n = static_cast<int>(configs.size());
   std::vector<std::unique_ptr<Scene>> scenes;
   for (const Config& c : configs) {
     SceneDesc d = base;
@@ -188,7 +196,7 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
   ref_opt.quiet = true;
   ref_opt.seed = 1000003;
   int c_mis = 0;
-  while (std::string(configs[c_mis].name) != "mfp + mis") ++c_mis;
+  while (configs[c_mis].name != "mfp + mis") ++c_mis;
   const RenderResult ref_res = render(*scenes[static_cast<size_t>(c_mis)], ref_opt);
   std::vector<double> ref(cells);
   for (size_t i = 0; i < cells; ++i)
@@ -239,7 +247,7 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
     return mse;
   };
   int c_ref = 0;  // mfp + collision: the baseline
-  while (std::string(configs[c_ref].name) != "mfp + collision") ++c_ref;
+  while (configs[c_ref].name != "mfp + collision") ++c_ref;
   const std::vector<double> mse_c = mse_of(c_ref);
   const std::vector<double> mse_block_c = mse_block_of(c_ref);
   const double time_c = median(secs[static_cast<size_t>(c_ref)]);
@@ -314,7 +322,7 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
     char late_text[32] = "           -";  // no late cell with signal
     if (!late.empty()) std::snprintf(late_text, sizeof(late_text), "%11.2fx", median(late));
     std::printf("%s %-31s %10.3g %11.2fx %s %11.2fx %11.3fx %10.3f +- %.3f %8.2fx / %5.2fx\n",
-                configs[k].is_default ? "*" : " ", configs[k].name,
+                configs[k].is_default ? "*" : " ", configs[k].name.c_str(),
                 static_cast<double>(stats[static_cast<size_t>(k)].paths) / t, median(all),
                 late_text, block_eff.empty() ? 0.0 : median(block_eff),
                 sum_mse > 0 ? (sum_mse_c * time_c) / (sum_mse * t) : 0.0, tm, std::sqrt(tv / reps),
@@ -352,10 +360,27 @@ int main(int argc, char** argv) {
       ro.all_cells = true;  // every cell with light counts, as in the corridors
     } else if (a == "--deciles") {
       ro.deciles = true;
+    } else if (a == "--roulette" && i + 1 < argc) {
+      // DEPTH,THRESHOLD as `femto render --russian-roulette` takes it
+      RouletteDesc r;
+      char comma = 0;
+      int used = 0;
+      const std::string v = argv[++i];
+      if (std::sscanf(v.c_str(), "%d%c%lf%n", &r.depth, &comma, &r.threshold, &used) != 3 ||
+          comma != ',' || used != static_cast<int>(v.size()) || r.depth < 1 || !(r.threshold > 0) ||
+          !std::isfinite(r.threshold)) {
+        std::fprintf(stderr,
+                     "femto-bench-sampling: --roulette \"%s\": expected DEPTH,THRESHOLD with "
+                     "DEPTH >= 1 and THRESHOLD > 0, e.g. 8,2\n",
+                     v.c_str());
+        return 2;
+      }
+      ro.roulettes.push_back(r);
     } else {
       std::fprintf(stderr,
                    "usage: femto-bench-sampling [--reps N (seeds, >= 3)] [--spp-scale X] "
-                   "[--scene NAME] [--all-cells] [--deciles]  (run from the repository root: "
+                   "[--scene NAME] [--all-cells] [--deciles] [--roulette D,T]...  (run from the "
+                   "repository root: "
                    "the cloud reads data/volumes/cloud.vdb)\n");
       return 2;
     }
