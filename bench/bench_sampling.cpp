@@ -361,7 +361,8 @@ int main(int argc, char** argv) {
     } else if (a == "--deciles") {
       ro.deciles = true;
     } else if (a == "--roulette" && i + 1 < argc) {
-      // DEPTH,THRESHOLD as `femto render --russian-roulette` takes it
+      // DEPTH,THRESHOLD as in `femto render --russian-roulette`, except that a threshold above 1
+      // is allowed here (a cut of about 1 - 1/T at vertex DEPTH, for studies)
       RouletteDesc r;
       char comma = 0;
       int used = 0;
