@@ -19,7 +19,8 @@ struct SurfaceHit {
 class Geometry {
  public:
   /// closed_form_cells: rays that start inside a box or sphere that nothing else touches find
-  /// their exit in closed form instead of in Embree (false only to test that shortcut).
+  /// their exit in closed form instead of in Embree, and in scenes made only of such shapes a ray
+  /// that misses every shape's bounds skips Embree (false only to test these shortcuts).
   explicit Geometry(const SceneDesc& scene, bool closed_form_cells = true);
   ~Geometry();
   Geometry(const Geometry&) = delete;
