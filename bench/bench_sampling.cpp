@@ -10,7 +10,8 @@
 // that leaves out most of the light scores well on the medians. The default configuration is
 // marked; it plays the scene's default Russian roulette, which every other configuration leaves off
 // ("default, no roulette" is the same sampling without it; `--roulette D,T` adds the same sampling
-// with other roulettes).
+// with other roulettes; `--max-depth N` renders scattering orders up to N only, to see which
+// order a configuration wins or loses on).
 //
 // Error measure: per cell (pixel x bin, channels summed), the mean squared error of one render
 // against a long reference render (32x the samples, seeds of its own, so uncorrelated with every
@@ -119,6 +120,7 @@ struct RunOptions {
   bool all_cells = false;
   bool deciles = false;  ///< also "default vs it" per tenth of the window
   std::vector<RouletteDesc> roulettes;  ///< extra configurations: the default with these
+  int max_depth = 1000;  ///< scattering orders rendered (1: single scattering), reference too
 };
 
 void run_scene(const BenchScene& bs, const RunOptions& ro) {
@@ -178,6 +180,7 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
       opt.quiet = true;
       opt.seed = 1 + static_cast<uint64_t>(r);
       opt.roulette = configs[k].roulette;
+      opt.max_depth = ro.max_depth;
       const RenderResult res = render(*scenes[static_cast<size_t>(k)], opt);
       secs[static_cast<size_t>(k)].push_back(res.wall_seconds);
       stats[static_cast<size_t>(k)] = res.stats;
@@ -195,6 +198,7 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
   ref_opt.threads = 0;
   ref_opt.quiet = true;
   ref_opt.seed = 1000003;
+  ref_opt.max_depth = ro.max_depth;
   int c_mis = 0;
   while (configs[c_mis].name != "mfp + mis") ++c_mis;
   const RenderResult ref_res = render(*scenes[static_cast<size_t>(c_mis)], ref_opt);
@@ -262,14 +266,17 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
   for (size_t j = 0; j < blocks; ++j)
     if (ref_block[j] > min_signal * peak_block)
       rel_block.push_back(std::sqrt(mse_block_c[j]) / ref_block[j]);
+  const std::string depth_note =
+      ro.max_depth < 1000 ? ", up to " + std::to_string(ro.max_depth) + " scattering vertices"
+                          : std::string();
   std::printf(
-      "\n%s: %d x %d px, %d bins, %d spp x %d seeds, %.2f medium events per path\n"
+      "\n%s: %d x %d px, %d bins, %d spp x %d seeds, %.2f medium events per path%s\n"
       "  mfp + collision, one render: median relative RMS error %.2f per cell (%zu cells), "
       "%.2f per block of %d x %d px x %d bins (%zu blocks)\n",
       bs.name, width, height, bins, spp, reps,
       static_cast<double>(stats[static_cast<size_t>(c_ref)].medium_events) /
           static_cast<double>(stats[static_cast<size_t>(c_ref)].paths),
-      rel_cell.empty() ? 0.0 : median(rel_cell), rel_cell.size(),
+      depth_note.c_str(), rel_cell.empty() ? 0.0 : median(rel_cell), rel_cell.size(),
       rel_block.empty() ? 0.0 : median(rel_block), kBlockPx, kBlockPx, kBlockBins,
       rel_block.size());
   std::printf("  %-31s %10s %12s %12s %12s %12s %18s %19s\n", "configuration", "paths/s",
@@ -377,10 +384,24 @@ int main(int argc, char** argv) {
         return 2;
       }
       ro.roulettes.push_back(r);
+    } else if (a == "--max-depth" && i + 1 < argc) {
+      // Scattering orders up to N (1: single scattering): which order a configuration wins on.
+      const std::string v = argv[++i];
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end != '\0' || n < 1 || n > 1000000) {
+        std::fprintf(stderr,
+                     "femto-bench-sampling: --max-depth \"%s\": expected an integer in "
+                     "[1, 1000000]\n",
+                     v.c_str());
+        return 2;
+      }
+      ro.max_depth = static_cast<int>(n);
     } else {
       std::fprintf(stderr,
                    "usage: femto-bench-sampling [--reps N (seeds, >= 3)] [--spp-scale X] "
-                   "[--scene NAME] [--all-cells] [--deciles] [--roulette D,T]...  (run from the "
+                   "[--scene NAME] [--all-cells] [--deciles] [--roulette D,T]... [--max-depth N]  "
+                   "(run from the "
                    "repository root: "
                    "the cloud reads data/volumes/cloud.vdb)\n");
       return 2;
