@@ -238,7 +238,7 @@ void Geometry::find_empty_cells(const SceneDesc& desc) {
   }
   // Only where every shape is such a cell (separate boxes and spheres: fog banks, blocks of
   // tissue, lamps): there a ray outside them often meets nothing; in a room of walls a ray always
-  // meets one, and the test would only add its cost (6% in the bench's room).
+  // meets one, and the test would only add its cost.
   if (n > 0 && m.cells.size() == n) {
     m.box_lo = lo;
     m.box_hi = hi;
