@@ -17,6 +17,12 @@
 // against a long reference render (32x the samples, seeds of its own, so uncorrelated with every
 // configuration), times the 1-thread render time. A squared error, not a variance: an estimator
 // whose rare large values most runs miss shows up as a shortfall in every run.
+//
+// "default vs it" is that product's ratio cell by cell (median over cells / blocks); "at equal
+// paths" is the squared errors' ratio alone. The latter depends only on the seeds, so two builds
+// compare on it exactly; the render times swing with the host's load (run one bench at a time:
+// a second one, or its 2-thread reference render, takes time from whichever configurations are
+// rendering then).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -279,9 +285,9 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
       depth_note.c_str(), rel_cell.empty() ? 0.0 : median(rel_cell), rel_cell.size(),
       rel_block.empty() ? 0.0 : median(rel_block), kBlockPx, kBlockPx, kBlockBins,
       rel_block.size());
-  std::printf("  %-31s %10s %12s %12s %12s %12s %18s %19s\n", "configuration", "paths/s",
+  std::printf("  %-31s %10s %12s %12s %12s %12s %18s %19s %17s\n", "configuration", "paths/s",
               "median eff.", "late eff.", "block eff.", "film eff.", "total vs reference",
-              "default vs it");
+              "default vs it", "at equal paths");
   // The default against each configuration directly: the median over cells (blocks) of the
   // configuration's MSE x time over the default's. A ratio of two medians against the baseline
   // (the eff. columns) can differ from it, since different cells decide each median.
@@ -328,13 +334,18 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
     for (double x : totals) tv += (x - tm) * (x - tm) / (reps - 1);
     char late_text[32] = "           -";  // no late cell with signal
     if (!late.empty()) std::snprintf(late_text, sizeof(late_text), "%11.2fx", median(late));
-    std::printf("%s %-31s %10.3g %11.2fx %s %11.2fx %11.3fx %10.3f +- %.3f %8.2fx / %5.2fx\n",
-                configs[k].is_default ? "*" : " ", configs[k].name.c_str(),
-                static_cast<double>(stats[static_cast<size_t>(k)].paths) / t, median(all),
-                late_text, block_eff.empty() ? 0.0 : median(block_eff),
-                sum_mse > 0 ? (sum_mse_c * time_c) / (sum_mse * t) : 0.0, tm, std::sqrt(tv / reps),
-                vs_def.empty() ? 0.0 : median(vs_def),
-                vs_def_block.empty() ? 0.0 : median(vs_def_block));
+    // The same at equal paths (every configuration renders the same spp): the squared errors'
+    // ratio alone, which depends on the seeds only, not on how busy the host was.
+    const double vs_def_cells = vs_def.empty() ? 0.0 : median(vs_def);
+    const double vs_def_blocks = vs_def_block.empty() ? 0.0 : median(vs_def_block);
+    std::printf(
+        "%s %-31s %10.3g %11.2fx %s %11.2fx %11.3fx %10.3f +- %.3f %8.2fx / %5.2fx %7.2fx / "
+        "%5.2fx\n",
+        configs[k].is_default ? "*" : " ", configs[k].name.c_str(),
+        static_cast<double>(stats[static_cast<size_t>(k)].paths) / t, median(all), late_text,
+        block_eff.empty() ? 0.0 : median(block_eff),
+        sum_mse > 0 ? (sum_mse_c * time_c) / (sum_mse * t) : 0.0, tm, std::sqrt(tv / reps),
+        vs_def_cells, vs_def_blocks, vs_def_cells * time_def / t, vs_def_blocks * time_def / t);
     if (ro.deciles && k != c_def) {
       // Where in the window the default wins or loses against this configuration: the same
       // cell-by-cell median, per tenth of the bins.

@@ -460,7 +460,8 @@ TEST_CASE("auto's third rule: thin segments, lights outside the scattering media
           "[time-sampling]") {
   CHECK(thin_segment(40.0, 1e4, 0.02));        // optical depth 0.8
   CHECK_FALSE(thin_segment(60.0, 1e4, 0.02));  // 1.2
-  CHECK_FALSE(thin_segment(4.0, 1e4, 0.02));   // 0.08: too little light for a shadow ray
+  CHECK(thin_segment(4.0, 1e4, 0.02));         // 0.08
+  CHECK_FALSE(thin_segment(2.0, 1e4, 0.02));   // 0.04: too little light for a shadow ray
   CHECK(thin_segment(1e3, 40.0, 0.02));        // the window ends first: 0.8
   CHECK_FALSE(thin_segment(std::numeric_limits<double>::infinity(), 1e3, 0.01));
   const SceneDesc d = load_scene_string(R"({

@@ -24,13 +24,13 @@
 // (uniform in time), the two weighted by the balance heuristic.
 // Third rule, for media less than a mean free path across (a bank of thin fog) lit only by
 // lights outside every scattering medium: a segment there whose reachable part has optical depth
-// between 0.1 and 1 gets the same pair, whatever side the light is on. Fewer than 1 - 1/e of such
+// between 0.05 and 1 gets the same pair, whatever side the light is on. Fewer than 1 - 1/e of such
 // segments hold a collision, while the connection puts a vertex on every one, spread over the
 // window, and with the light outside the medium its term along the segment has no 1/r^2 peak.
 // Measured (femto-bench-sampling, docs/PERFORMANCE.md): with the light inside the medium the extra
 // shadow rays cost more than they save (thin fog box and room), as they do on the rare thin
-// segments of an optically thick medium (tissue) and on segments thinner than 0.1 (the narrow
-// corridor).
+// segments of an optically thick medium (tissue) and on segments thinner than 0.05 (the narrow
+// corridor's crossings, 0.02-0.04 deep: a shadow ray on each).
 #include <cmath>
 #include <limits>
 
@@ -119,9 +119,10 @@ inline bool starved_segment(double s_surf, double budget, double sigma_t) {
 
 /// Optical depths of a segment's reachable part between which auto adds a line-to-point
 /// connection under the third rule: below kThinDepth most such segments hold no collision; below
-/// kThinMinDepth a segment gathers too little light to pay for a shadow ray of its own. A medium
-/// thinner than kThinDepth across its bounding box is one where such segments are the rule.
-constexpr double kThinDepth = 1.0, kThinMinDepth = 0.1;
+/// kThinMinDepth a segment gathers too little light to pay for a shadow ray of its own (0.05
+/// measured better than 0.1 and 0 in both fog corridors). A medium thinner than kThinDepth across
+/// its bounding box is one where such segments are the rule.
+constexpr double kThinDepth = 1.0, kThinMinDepth = 0.05;
 
 /// Whether a segment of length s_surf, with extinction sigma_t (spread_sigma_t) and `budget` mm
 /// of light travel left in the window, is optically thin enough for the third rule.
