@@ -15,14 +15,15 @@
 //
 // Error measure: per cell (pixel x bin, channels summed), the mean squared error of one render
 // against a long reference render (32x the samples, seeds of its own, so uncorrelated with every
-// configuration), times the 1-thread render time. A squared error, not a variance: an estimator
-// whose rare large values most runs miss shows up as a shortfall in every run.
+// configuration), times the 1-thread render time (the process's CPU time; `--wall-time`: the
+// wall clock, which also counts time the core spent on other programs; the default's median over
+// seeds, and each other configuration's as a median of per-seed ratios to it: time_of). A
+// squared error, not a variance: an estimator whose rare large values most runs miss shows up as
+// a shortfall in every run.
 //
 // "default vs it" is that product's ratio cell by cell (median over cells / blocks); "at equal
 // paths" is the squared errors' ratio alone. The latter depends only on the seeds, so two builds
-// compare on it exactly; the render times swing with the host's load (run one bench at a time:
-// a second one, or its 2-thread reference render, takes time from whichever configurations are
-// rendering then).
+// compare on it exactly; the render times still move with the host's load.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -40,6 +41,7 @@
 using namespace femto;
 using femto::bench::cpu_model;
 using femto::bench::median;
+using femto::bench::process_cpu_s;
 
 namespace {
 
@@ -127,6 +129,7 @@ struct RunOptions {
   bool deciles = false;  ///< also "default vs it" per tenth of the window
   std::vector<RouletteDesc> roulettes;  ///< extra configurations: the default with these
   int max_depth = 1000;  ///< scattering orders rendered (1: single scattering), reference too
+  bool wall_time = false;  ///< time renders by the wall clock instead of the process's CPU time
 };
 
 void run_scene(const BenchScene& bs, const RunOptions& ro) {
@@ -187,8 +190,10 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
       opt.seed = 1 + static_cast<uint64_t>(r);
       opt.roulette = configs[k].roulette;
       opt.max_depth = ro.max_depth;
+      const double cpu0 = process_cpu_s();
       const RenderResult res = render(*scenes[static_cast<size_t>(k)], opt);
-      secs[static_cast<size_t>(k)].push_back(res.wall_seconds);
+      secs[static_cast<size_t>(k)].push_back(ro.wall_time ? res.wall_seconds
+                                                          : process_cpu_s() - cpu0);
       stats[static_cast<size_t>(k)] = res.stats;
       const TransientFilm& f = res.film;
       width = f.width(), height = f.height(), bins = f.bins();
@@ -258,9 +263,21 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
   };
   int c_ref = 0;  // mfp + collision: the baseline
   while (configs[c_ref].name != "mfp + collision") ++c_ref;
+  int c_def = 0;
+  while (!configs[c_def].is_default) ++c_def;
+  // A configuration's time per render: the default's median times the median over seeds of its
+  // time over the default's in the same round. Renders of one round run back to back, so a
+  // change in the host's load between rounds (another program starting or ending) cancels.
+  const std::vector<double>& secs_def = secs[static_cast<size_t>(c_def)];
+  auto time_of = [&](int k) {
+    std::vector<double> ratio;
+    for (size_t r = 0; r < secs_def.size(); ++r)
+      ratio.push_back(secs[static_cast<size_t>(k)][r] / secs_def[r]);
+    return median(secs_def) * median(ratio);
+  };
   const std::vector<double> mse_c = mse_of(c_ref);
   const std::vector<double> mse_block_c = mse_block_of(c_ref);
-  const double time_c = median(secs[static_cast<size_t>(c_ref)]);
+  const double time_c = time_of(c_ref);
   double ref_total = 0;
   for (size_t i = 0; i < cells; ++i) ref_total += ref[i];
   // How noisy one baseline render is where it counts: the median relative RMS error of its
@@ -291,12 +308,10 @@ void run_scene(const BenchScene& bs, const RunOptions& ro) {
   // The default against each configuration directly: the median over cells (blocks) of the
   // configuration's MSE x time over the default's. A ratio of two medians against the baseline
   // (the eff. columns) can differ from it, since different cells decide each median.
-  int c_def = 0;
-  while (!configs[c_def].is_default) ++c_def;
   const std::vector<double> mse_def = mse_of(c_def), mse_block_def = mse_block_of(c_def);
-  const double time_def = median(secs[static_cast<size_t>(c_def)]);
+  const double time_def = time_of(c_def);
   for (int k = 0; k < n; ++k) {
-    const double t = median(secs[static_cast<size_t>(k)]);
+    const double t = time_of(k);
     const std::vector<double> mse = mse_of(k);
     std::vector<double> vs_def, vs_def_block;
     std::vector<std::vector<double>> by_tenth(10);  // vs_def per tenth of the window
@@ -378,6 +393,8 @@ int main(int argc, char** argv) {
       ro.all_cells = true;  // every cell with light counts, as in the corridors
     } else if (a == "--deciles") {
       ro.deciles = true;
+    } else if (a == "--wall-time") {
+      ro.wall_time = true;
     } else if (a == "--roulette" && i + 1 < argc) {
       // DEPTH,THRESHOLD as in `femto render --russian-roulette`, except that a threshold above 1
       // is allowed here (a cut of about 1 - 1/T at vertex DEPTH, for studies)
@@ -411,10 +428,9 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: femto-bench-sampling [--reps N (seeds, >= 3)] [--spp-scale X] "
-                   "[--scene NAME] [--all-cells] [--deciles] [--roulette D,T]... [--max-depth N]  "
-                   "(run from the "
-                   "repository root: "
-                   "the cloud reads data/volumes/cloud.vdb)\n");
+                   "[--scene NAME] [--all-cells] [--deciles] [--roulette D,T]... [--max-depth N] "
+                   "[--wall-time]  (run from the repository root: the cloud reads "
+                   "data/volumes/cloud.vdb)\n");
       return 2;
     }
   }
@@ -482,9 +498,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::printf(
-      "femto-bench-sampling: CPU %s; 1 thread; efficiency = (MSE x time) of mfp + "
+      "femto-bench-sampling: CPU %s; 1 thread; time: %s; efficiency = (MSE x time) of mfp + "
       "collision over the configuration's, per pixel-bin cell (> 1: better); * = default\n",
-      cpu_model().c_str());
+      cpu_model().c_str(), ro.wall_time ? "wall clock" : "the process's CPU time");
   for (const BenchScene& bs : list)
     if (only.empty() || only == bs.name) run_scene(bs, ro);
   return 0;
