@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "core/constants.h"
 #include "core/default_scene.h"
 #include "core/integrators/volpath.h"
@@ -37,20 +38,11 @@
 #include "tests/single_scatter.h"
 
 using namespace femto;
+using femto::bench::now_s;
+using femto::bench::process_cpu_s;
 
 namespace {
 
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-/// CPU time of the whole process (all threads), s: less sensitive than wall time to other
-/// programs sharing the cores.
-double cpu_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 /// CPU time of the calling thread, s (a render with 1 thread runs on the calling thread).
 double thread_cpu_s() {
   timespec ts{};
@@ -726,9 +718,9 @@ int cost(const Options& opt) {
         o.seed = opt.seed;
         o.threads = threads;
         o.quiet = true;
-        const double t = now_s(), c = cpu_s();
+        const double t = now_s(), c = process_cpu_s();
         const RenderResult r = render(kernel_now ? kern : hist, o);
-        const double dt = now_s() - t, dc = cpu_s() - c;
+        const double dt = now_s() - t, dc = process_cpu_s() - c;
         paths = r.stats.paths;
         double& w = kernel_now ? wall_k : wall_h;
         double& cp = kernel_now ? cpu_k : cpu_h;
